@@ -1,0 +1,302 @@
+"""The compass on synthetic panoramas whose true heading is known."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.conftest import learned_compass
+from vc_gym.compass import (
+    Camera,
+    CompassConfig,
+    MapFileError,
+    NotLearnedError,
+    VisualCompass,
+    wrap180,
+)
+from vc_gym.compass.synthetic import render_view
+
+
+def heading_errors(vc, pano, yaws, **cam_kwargs):
+    errs = []
+    for yaw in yaws:
+        img = render_view(pano, Camera(yaw_deg=yaw, **cam_kwargs))
+        est = vc.estimate(img, Camera(**cam_kwargs))
+        errs.append(abs(wrap180(est.heading_deg - yaw)))
+    return np.array(errs)
+
+
+def test_recovers_random_yaws_in_a_room(room_pano, room_compass):
+    yaws = np.random.default_rng(11).uniform(0.0, 360.0, 60)
+    errs = heading_errors(room_compass, room_pano, yaws)
+    assert np.mean(errs < 5.0) >= 0.95, np.sort(errs)[-5:]
+
+
+def test_recovers_random_yaws_outdoors(outdoor_pano):
+    vc = learned_compass(outdoor_pano)
+    yaws = np.random.default_rng(12).uniform(0.0, 360.0, 40)
+    errs = heading_errors(vc, outdoor_pano, yaws)
+    assert np.mean(errs < 5.0) >= 0.95, np.sort(errs)[-5:]
+
+
+def test_three_colour_classes_suffice(room_pano):
+    vc = learned_compass(room_pano, CompassConfig(n_colors=3))
+    yaws = np.random.default_rng(13).uniform(0.0, 360.0, 30)
+    assert np.mean(heading_errors(vc, room_pano, yaws) < 5.0) >= 0.9
+
+
+def test_sparse_scanning_grid_still_works(room_pano):
+    # paper 5.3: coverage can go below 1 % without much loss
+    vc = learned_compass(room_pano, CompassConfig(coverage=0.01))
+    assert vc.config.grid_steps == (10, 10)
+    yaws = np.random.default_rng(14).uniform(0.0, 360.0, 30)
+    assert np.median(heading_errors(vc, room_pano, yaws)) < 5.0
+
+
+def test_wrap_around_zero(room_pano, room_compass):
+    errs = heading_errors(room_compass, room_pano, [359.6, 0.0, 0.4, 358.0, 2.0])
+    assert np.all(errs < 3.0)
+    est = room_compass.estimate(render_view(room_pano, Camera(yaw_deg=-0.3)), Camera())
+    assert 0.0 <= est.heading_deg < 360.0
+
+
+def test_learning_across_zero_updates_sectors_on_both_sides(room_pano):
+    vc = VisualCompass()
+    vc.fit_colors([render_view(room_pano, Camera())])
+    n = vc.learn(render_view(room_pano, Camera(yaw_deg=1.0)), Camera(yaw_deg=1.0))
+    seen = np.flatnonzero(vc.sector_observations)
+    assert n == seen.size
+    assert 0 in seen and vc.config.n_sectors - 1 in seen
+    # only the sectors in view (hfov 56.9 deg around 1 deg) are updated
+    directions = (seen + 0.5) * vc.config.sector_deg
+    assert np.all(np.abs(wrap180(directions - 1.0)) < 56.9 / 2 + vc.config.sector_deg)
+
+
+def test_pitch_is_handled(room_pano, room_compass):
+    yaws = np.random.default_rng(15).uniform(0.0, 360.0, 15)
+    errs = heading_errors(room_compass, room_pano, yaws, pitch_deg=8.0)
+    assert np.mean(errs < 5.0) >= 0.9
+
+
+@pytest.mark.parametrize("illumination", [0.5, 0.25, 1.5])
+def test_exposure_mean_undoes_illumination_changes(room_pano, illumination):
+    # paper 5.3 tests half the illumination of learning; exposure="mean" undoes it
+    vc = learned_compass(room_pano, CompassConfig(exposure="mean"))
+    yaws = np.random.default_rng(16).uniform(0.0, 360.0, 20)
+    errs = []
+    for yaw in yaws:
+        img = render_view(room_pano, Camera(yaw_deg=yaw), illumination=illumination)
+        errs.append(abs(wrap180(vc.estimate(img, Camera()).heading_deg - yaw)))
+    assert np.mean(np.array(errs) < 5.0) >= 0.95, np.round(errs, 1)
+
+
+def test_exposure_reference_survives_save_load(tmp_path, room_pano):
+    vc = learned_compass(room_pano, CompassConfig(exposure="mean", n_colors=4))
+    loaded = VisualCompass.load(vc.save(tmp_path / "m.npz"))
+    img = render_view(room_pano, Camera(yaw_deg=33.0), illumination=0.5)
+    np.testing.assert_array_equal(
+        loaded.log_likelihood(img, Camera()), vc.log_likelihood(img, Camera())
+    )
+
+
+def test_likelihood_shape_and_estimate_fields(room_pano, room_compass):
+    img = render_view(room_pano, Camera(yaw_deg=123.0))
+    ll = room_compass.log_likelihood(img, Camera())
+    assert ll.shape == room_compass.headings_deg.shape == (360,)
+    assert ll.dtype == np.float64 and np.all(np.isfinite(ll))
+    est = room_compass.estimate(img, Camera())
+    assert est.n_sectors in (12, 13, 14)
+    assert est.score <= 0.0
+    assert 0.0 <= est.spread_deg < 10.0
+    np.testing.assert_array_equal(est.log_likelihood, ll)
+
+
+def test_unlearned_sectors_are_neutral(room_pano):
+    vc = VisualCompass(CompassConfig(n_colors=4))
+    vc.fit_colors([render_view(room_pano, Camera())])
+    vc.learn(render_view(room_pano, Camera(yaw_deg=0.0)), Camera(yaw_deg=0.0))
+    # a view of the opposite side sees only sectors the map never learned
+    ll = vc.log_likelihood(render_view(room_pano, Camera(yaw_deg=180.0)), Camera())
+    far = np.abs(wrap180(vc.headings_deg - 180.0)) < 20.0
+    np.testing.assert_allclose(ll[far], 0.0, atol=1e-9)
+
+
+def test_temperature_scales_log_likelihood(room_pano, room_compass):
+    img = render_view(room_pano, Camera(yaw_deg=40.0))
+    hot = VisualCompass.__new__(VisualCompass)
+    hot.__dict__.update(room_compass.__dict__)
+    hot.config = CompassConfig(temperature=4.0)
+    np.testing.assert_allclose(
+        hot.log_likelihood(img, Camera()), room_compass.log_likelihood(img, Camera()) / 4.0
+    )
+
+
+def test_bgr_input_scores_worse_than_rgb(room_pano, room_compass):
+    """Documented behaviour: BGR cannot be detected, but it fits the map visibly worse."""
+    img = render_view(room_pano, Camera(yaw_deg=70.0))
+    rgb = room_compass.estimate(img, Camera()).score
+    bgr = room_compass.estimate(np.ascontiguousarray(img[..., ::-1]), Camera()).score
+    assert bgr < rgb
+
+
+def test_transposed_image_is_rejected(room_pano, room_compass):
+    img = render_view(room_pano, Camera(yaw_deg=70.0))
+    with pytest.raises(ValueError, match="transposed"):
+        room_compass.log_likelihood(np.ascontiguousarray(img.transpose(1, 0, 2)), Camera())
+
+
+def test_nothing_above_horizon(room_pano, room_compass):
+    img = render_view(room_pano, Camera(yaw_deg=10.0, pitch_deg=-80.0))
+    ll = room_compass.log_likelihood(img, Camera(pitch_deg=-80.0))
+    assert np.all(ll == 0.0)
+    vc = VisualCompass()
+    vc.fit_colors([img])
+    assert vc.learn(img, Camera(pitch_deg=-80.0)) == 0
+    assert vc.frames_learned == 0
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        np.zeros((160, 208, 3), dtype=np.float32),
+        np.zeros((160, 208), dtype=np.uint8),
+        np.zeros((160, 208, 4), dtype=np.uint8),
+        np.zeros((0, 208, 3), dtype=np.uint8),
+        [[1, 2, 3]],
+    ],
+)
+def test_bad_images_are_rejected(room_compass, bad):
+    with pytest.raises(ValueError):
+        room_compass.log_likelihood(bad, Camera())
+    with pytest.raises(ValueError):
+        room_compass.learn(bad, Camera())
+
+
+def test_not_learned_errors(room_pano):
+    img = render_view(room_pano, Camera())
+    vc = VisualCompass()
+    with pytest.raises(NotLearnedError, match="fit_colors"):
+        vc.learn(img, Camera())
+    vc.fit_colors([img])
+    with pytest.raises(NotLearnedError, match="empty"):
+        vc.log_likelihood(img, Camera())
+    with pytest.raises(NotLearnedError):
+        VisualCompass().save("never.npz")
+
+
+def test_refitting_colours_needs_reset(room_pano, room_compass):
+    img = render_view(room_pano, Camera())
+    vc = learned_compass(room_pano, CompassConfig(n_colors=3))
+    with pytest.raises(ValueError, match="reset_map"):
+        vc.fit_colors([img])
+    vc.fit_colors([img], reset_map=True)
+    assert vc.frames_learned == 0 and not vc.is_learned
+
+
+def test_bad_camera_argument(room_pano, room_compass):
+    img = render_view(room_pano, Camera())
+    with pytest.raises(ValueError, match="Camera"):
+        room_compass.log_likelihood(img, {"hfov_deg": 56.9})
+
+
+def test_config_validation():
+    for bad in (
+        {"n_colors": 0},
+        {"sector_deg": 7.0},
+        {"n_bins": 1},
+        {"coverage": 0.0},
+        {"coverage": float("nan")},
+        {"heading_step_deg": 0.7},
+        {"smoothing": -1.0},
+        {"temperature": 0.0},
+        {"n_colors": 2.5},
+    ):
+        with pytest.raises(ValueError):
+            CompassConfig(**bad)
+
+
+# ------------------------------------------------------------------ persistence
+def test_save_load_round_trip_gives_identical_likelihoods(tmp_path, room_pano, room_compass):
+    path = room_compass.save(tmp_path / "map")
+    assert path.suffix == ".npz" and path.exists()
+    loaded = VisualCompass.load(path)
+    assert loaded.config == room_compass.config
+    assert loaded.frames_learned == room_compass.frames_learned
+    for yaw in (0.0, 91.0, 250.5):
+        img = render_view(room_pano, Camera(yaw_deg=yaw))
+        np.testing.assert_array_equal(
+            loaded.log_likelihood(img, Camera()), room_compass.log_likelihood(img, Camera())
+        )
+    assert not list(tmp_path.glob("*.tmp")), "temporary file left behind"
+
+
+def test_load_rejects_truncated_file(tmp_path, room_compass):
+    path = room_compass.save(tmp_path / "map.npz")
+    data = path.read_bytes()
+    bad = tmp_path / "truncated.npz"
+    bad.write_bytes(data[: len(data) // 2])
+    with pytest.raises(MapFileError, match="truncated.npz"):
+        VisualCompass.load(bad)
+
+
+def test_load_rejects_empty_missing_and_garbage(tmp_path):
+    empty = tmp_path / "empty.npz"
+    empty.write_bytes(b"")
+    with pytest.raises(MapFileError, match="empty"):
+        VisualCompass.load(empty)
+    with pytest.raises(MapFileError, match="no such file"):
+        VisualCompass.load(tmp_path / "missing.npz")
+    garbage = tmp_path / "garbage.npz"
+    garbage.write_bytes(b"not a zip file at all" * 10)
+    with pytest.raises(MapFileError):
+        VisualCompass.load(garbage)
+
+
+def _rewrite(path, out, **changes):
+    with np.load(path, allow_pickle=False) as d:
+        arrays = {k: d[k] for k in d.files}
+    arrays.update(changes)
+    np.savez(out, **arrays)
+    return out
+
+
+def test_load_rejects_other_version_schema_and_config(tmp_path, room_compass):
+    path = room_compass.save(tmp_path / "map.npz")
+    with pytest.raises(MapFileError, match="version 99"):
+        VisualCompass.load(_rewrite(path, tmp_path / "v.npz", schema_version=np.array(99)))
+    with pytest.raises(MapFileError, match="expected"):
+        VisualCompass.load(_rewrite(path, tmp_path / "s.npz", schema=np.array("other")))
+    with pytest.raises(MapFileError, match="was learned with"):
+        VisualCompass.load(path, config=CompassConfig(n_colors=3))
+    wrong = np.zeros((3, 3, 3), dtype=np.uint32)
+    with pytest.raises(MapFileError, match="counts"):
+        VisualCompass.load(_rewrite(path, tmp_path / "c.npz", counts=wrong))
+    with pytest.raises(MapFileError, match="colour classes"):
+        VisualCompass.load(
+            _rewrite(path, tmp_path / "n.npz", colors_means=np.full((10, 3), np.nan))
+        )
+
+
+def test_load_never_unpickles(tmp_path, room_compass):
+    path = room_compass.save(tmp_path / "map.npz")
+    with np.load(path, allow_pickle=False) as d:
+        arrays = {k: d[k] for k in d.files}
+    arrays["config"] = np.array([{"evil": 1}], dtype=object)
+    evil = tmp_path / "evil.npz"
+    np.savez(evil, **arrays)
+    with pytest.raises(MapFileError):
+        VisualCompass.load(evil)
+
+
+def test_save_is_atomic_and_keeps_old_file_on_failure(tmp_path, room_compass, monkeypatch):
+    path = room_compass.save(tmp_path / "map.npz")
+    before = path.read_bytes()
+
+    def boom(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savez_compressed", boom)
+    with pytest.raises(OSError, match="disk full"):
+        room_compass.save(path)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.npz"]

@@ -1,0 +1,45 @@
+"""Shared fixtures: seeded synthetic scenes and the optional real photo folder."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vc_gym.compass import Camera, CompassConfig, VisualCompass
+from vc_gym.compass.synthetic import Panorama, make_panorama, render_view
+from vc_gym.experiments.real_data import default_real_data_dir
+
+#: Yaws of the learning frames: 8 body directions x 3 head pans (paper 4.3).
+LEARN_YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]
+
+
+@pytest.fixture(scope="session")
+def room_pano() -> Panorama:
+    return make_panorama(np.random.default_rng(7), width=2400, height=600, kind="room")
+
+
+@pytest.fixture(scope="session")
+def outdoor_pano() -> Panorama:
+    return make_panorama(np.random.default_rng(8), width=2400, height=600, kind="outdoor")
+
+
+def learned_compass(pano: Panorama, config: CompassConfig | None = None) -> VisualCompass:
+    """A compass that learned ``pano`` from LEARN_YAWS (colours fitted on the 0-pan views)."""
+    vc = VisualCompass(config)
+    vc.fit_colors([render_view(pano, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
+    for yaw in LEARN_YAWS:
+        vc.learn(render_view(pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
+    return vc
+
+
+@pytest.fixture(scope="session")
+def room_compass(room_pano: Panorama) -> VisualCompass:
+    return learned_compass(room_pano)
+
+
+@pytest.fixture(scope="session")
+def real_data_dir():
+    d = default_real_data_dir()
+    if d is None:
+        pytest.skip("real photos not found (set VC_GYM_REAL_DATA or place ../shared/data/real)")
+    return d

@@ -1,0 +1,85 @@
+"""Angle helpers shared by every part of vc_gym.
+
+All angles are in degrees, counter-clockwise positive seen from above. Differences
+are wrapped with :func:`wrap180`; angles are never averaged arithmetically
+(:func:`circular_mean` uses ``atan2(sum sin, sum cos)``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["wrap180", "wrap360", "circular_mean", "circular_std"]
+
+
+def wrap180(angle_deg: ArrayLike) -> np.ndarray | float:
+    """Wrap angles to the half-open interval ``[-180, 180)`` degrees.
+
+    Parameters
+    ----------
+    angle_deg : array_like
+        Angle(s) in degrees.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The wrapped angle(s); a Python float for scalar input.
+    """
+    a = np.asarray(angle_deg, dtype=float)
+    out = np.mod(a + 180.0, 360.0) - 180.0
+    # mod of a tiny negative number can round up to exactly 360 -> 180; keep [-180, 180)
+    out = np.where(out >= 180.0, out - 360.0, out)
+    return float(out) if out.ndim == 0 else out
+
+
+def wrap360(angle_deg: ArrayLike) -> np.ndarray | float:
+    """Wrap angles to the half-open interval ``[0, 360)`` degrees."""
+    a = np.asarray(angle_deg, dtype=float)
+    out = np.mod(a, 360.0)
+    out = np.where(out >= 360.0, out - 360.0, out)
+    return float(out) if out.ndim == 0 else out
+
+
+def _weights(angles: np.ndarray, weights: ArrayLike | None) -> np.ndarray:
+    if weights is None:
+        return np.ones_like(angles)
+    w = np.asarray(weights, dtype=float)
+    if w.shape != angles.shape:
+        raise ValueError(f"weights shape {w.shape} does not match angles shape {angles.shape}")
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError("weights must be finite and non-negative")
+    if w.sum() <= 0:
+        raise ValueError("weights must not all be zero")
+    return w
+
+
+def circular_mean(angle_deg: ArrayLike, weights: ArrayLike | None = None) -> float:
+    """Weighted circular mean, ``atan2(sum w sin, sum w cos)``, in ``[0, 360)`` degrees.
+
+    This is the estimate of paper eq. 26 for a belief over headings.
+    """
+    a = np.radians(np.asarray(angle_deg, dtype=float))
+    if a.size == 0:
+        raise ValueError("circular_mean needs at least one angle")
+    w = _weights(a, weights)
+    return float(wrap360(np.degrees(np.arctan2(np.sum(w * np.sin(a)), np.sum(w * np.cos(a))))))
+
+
+def circular_std(angle_deg: ArrayLike, weights: ArrayLike | None = None) -> float:
+    """Weighted circular standard deviation ``sqrt(-2 ln R)`` in degrees (paper eq. 27).
+
+    ``R`` is the mean resultant length. For concentrated distributions this equals
+    the ordinary standard deviation; for a uniform one it is infinite.
+    """
+    a = np.radians(np.asarray(angle_deg, dtype=float))
+    if a.size == 0:
+        raise ValueError("circular_std needs at least one angle")
+    w = _weights(a, weights)
+    r = np.hypot(np.sum(w * np.sin(a)), np.sum(w * np.cos(a))) / np.sum(w)
+    r = min(float(r), 1.0)
+    if r <= 0.0:
+        return float("inf")
+    return float(np.degrees(np.sqrt(max(-2.0 * math.log(r), 0.0))))

@@ -1,0 +1,817 @@
+"""Seeded 360° panoramas with known geometry, and pinhole views rendered from them.
+
+The visual compass is tested, demonstrated and benchmarked on camera views whose true
+heading is known. This module makes such views: :func:`make_panorama` paints a
+procedural, seamless 360° panorama (an indoor room or an outdoor scene) from a numpy
+random generator, :func:`equirectangular` wraps a real equirectangular photo, and
+:func:`render_view` cuts out the image a :class:`~vc_gym.compass.camera.Camera` would
+see at a given yaw and pitch.
+
+Conventions
+-----------
+Angles are in degrees, counter-clockwise positive seen from above (the convention of
+:mod:`vc_gym.angles` and :mod:`vc_gym.compass.camera`).
+
+A panorama is an ``(H, W, 3)`` ``uint8`` RGB image covering 360° of azimuth, seen from
+inside like a real panorama photo: moving right in the image turns *clockwise*.
+Column ``x`` (pixel centre at ``x + 0.5``) looks at azimuth::
+
+    a(x) = azimuth0_deg - 360 * (x + 0.5) / W        (mod 360)
+
+and row ``y`` (centre ``y + 0.5``) looks at elevation (equirectangular rows)::
+
+    e(y) = elev_top_deg - (elev_top_deg - elev_bottom_deg) * (y + 0.5) / H
+
+so ``azimuth0_deg`` is the azimuth of the *left edge* of column 0 (and of the right edge
+of column ``W - 1``: the image wraps there).
+
+A camera pixel ``(u, v)`` of a ``w x h`` view has the camera-frame ray
+``x = (u - cx) / f`` (right), ``y_up = (cy - v) / f`` (up), forward ``1``, with
+``f = (w / 2) / tan(hfov / 2)`` and ``(cx, cy)`` the principal point (default image
+centre ``((w - 1) / 2, (h - 1) / 2)``). Pitching the camera up by ``θ`` gives the world
+ray ``forward = cos θ - sin θ * y_up``, ``up = sin θ + cos θ * y_up``, ``left = -x``,
+which looks at::
+
+    azimuth   = yaw + atan2(left, forward)
+    elevation = atan2(up, hypot(forward, left))
+
+(:meth:`Camera.column_offsets_deg` is the azimuth part of this at a given row.)
+"""
+
+from __future__ import annotations
+
+import colorsys
+import functools
+import math
+from dataclasses import dataclass
+from numbers import Integral
+
+import cv2
+import numpy as np
+
+from vc_gym.angles import wrap180, wrap360
+from vc_gym.compass.camera import Camera
+from vc_gym.compass.exposure import gain_table
+from vc_gym.images import check_image
+
+__all__ = ["Panorama", "PANORAMA_KINDS", "make_panorama", "render_view", "equirectangular"]
+
+#: Scene kinds understood by :func:`make_panorama`.
+PANORAMA_KINDS = ("room", "outdoor")
+
+# Rows of replicated border each interpolation needs once the sample rows are clamped to
+# [0, H - 1]: linear reads row floor(y) + 1 only with weight 0 at y = H - 1 (so wrapping
+# is harmless), cubic reads 1 row before and 2 after, Lanczos 3 before and 4 after.
+_VERTICAL_PAD = {
+    cv2.INTER_NEAREST: 0,
+    cv2.INTER_LINEAR: 0,
+    cv2.INTER_CUBIC: 2,
+    cv2.INTER_LANCZOS4: 4,
+}
+# cv2.remap refuses sources with a side of SHRT_MAX (32767) pixels or more.
+_REMAP_MAX_SIDE = 32766
+
+
+def _finite(name: str, value: object) -> float:
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def _int_at_least(name: str, value: object, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, Integral):
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    if int(value) < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+    return int(value)
+
+
+# --------------------------------------------------------------------------- Panorama
+
+
+@dataclass(frozen=True, eq=False)
+class Panorama:
+    """A 360° panorama image together with the directions its pixels look at.
+
+    Column ``x`` looks at azimuth ``a(x) = azimuth0_deg - 360 (x + 0.5) / W`` (mod 360,
+    degrees, CCW positive: moving right in the image turns clockwise, as in a real
+    panorama photo seen from inside). Row ``y`` looks at elevation
+    ``e(y) = elev_top_deg - (elev_top_deg - elev_bottom_deg) (y + 0.5) / H``.
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        ``(H, W, 3)`` ``uint8`` RGB image covering 360° of azimuth. It is not copied;
+        do not modify it while the panorama is in use.
+    elev_top_deg, elev_bottom_deg : float
+        Elevation of the top edge of row 0 and of the bottom edge of row ``H - 1``;
+        ``-90 <= elev_bottom_deg < elev_top_deg <= 90``.
+    azimuth0_deg : float
+        Azimuth of the left edge of column 0 (degrees).
+
+    Raises
+    ------
+    ValueError
+        If the image is not an RGB ``uint8`` array or the elevations are invalid.
+
+    Notes
+    -----
+    Equality and hashing are by identity (the image is a numpy array).
+    """
+
+    image: np.ndarray
+    elev_top_deg: float = 45.0
+    elev_bottom_deg: float = -45.0
+    azimuth0_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        check_image(self.image, "panorama image")
+        top = _finite("elev_top_deg", self.elev_top_deg)
+        bottom = _finite("elev_bottom_deg", self.elev_bottom_deg)
+        if not (-90.0 <= top <= 90.0 and -90.0 <= bottom <= 90.0):
+            raise ValueError(
+                f"elev_top_deg and elev_bottom_deg must be in [-90, 90], got {top}, {bottom}"
+            )
+        if not top > bottom:
+            raise ValueError(
+                f"elev_top_deg must be greater than elev_bottom_deg, got {top} <= {bottom}"
+            )
+        object.__setattr__(self, "elev_top_deg", top)
+        object.__setattr__(self, "elev_bottom_deg", bottom)
+        object.__setattr__(self, "azimuth0_deg", _finite("azimuth0_deg", self.azimuth0_deg))
+
+    @property
+    def width(self) -> int:
+        """Number of columns ``W``."""
+        return int(self.image.shape[1])
+
+    @property
+    def height(self) -> int:
+        """Number of rows ``H``."""
+        return int(self.image.shape[0])
+
+    def azimuth_of_column(self, x: np.ndarray | float) -> np.ndarray | float:
+        """Azimuth in ``[0, 360)`` that column ``x`` (may be fractional) looks at."""
+        return wrap360(self.azimuth0_deg - 360.0 * (np.asarray(x, dtype=float) + 0.5) / self.width)
+
+    def column_of_azimuth(self, azimuth_deg: np.ndarray | float) -> np.ndarray | float:
+        """Fractional column (pixel-centre coordinates, in ``[0, W)``) of an azimuth.
+
+        Coordinate ``W - 0.5`` is the wrap between column ``W - 1`` and column 0.
+        """
+        offset = wrap360(self.azimuth0_deg - np.asarray(azimuth_deg, dtype=float))
+        out = np.mod(np.asarray(offset) * (self.width / 360.0) - 0.5, self.width)
+        return float(out) if np.ndim(out) == 0 else out
+
+    def elevation_of_row(self, y: np.ndarray | float) -> np.ndarray | float:
+        """Elevation (degrees) that row ``y`` (may be fractional) looks at."""
+        span = self.elev_top_deg - self.elev_bottom_deg
+        out = self.elev_top_deg - span * (np.asarray(y, dtype=float) + 0.5) / self.height
+        return float(out) if np.ndim(out) == 0 else out
+
+    def row_of_elevation(self, elevation_deg: np.ndarray | float) -> np.ndarray | float:
+        """Fractional row (pixel-centre coordinates) of an elevation; not clamped."""
+        span = self.elev_top_deg - self.elev_bottom_deg
+        e = np.asarray(elevation_deg, dtype=float)
+        out = (self.elev_top_deg - e) * (self.height / span) - 0.5
+        return float(out) if np.ndim(out) == 0 else out
+
+
+def equirectangular(image: np.ndarray, azimuth0_deg: float = 0.0) -> Panorama:
+    """Wrap a real full-sphere equirectangular photo as a :class:`Panorama`.
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        ``(H, W, 3)`` ``uint8`` **RGB** image (convert ``cv2.imread`` output with
+        ``cv2.cvtColor(img, cv2.COLOR_BGR2RGB)``) whose rows span elevation +90° (top
+        edge) to -90° (bottom edge) and whose columns span 360° of azimuth, turning
+        clockwise to the right (the usual layout of 360° cameras). Usually ``W = 2H``.
+    azimuth0_deg : float
+        Azimuth of the left edge of column 0. If the centre column of the photo should
+        be azimuth ``A``, pass ``A + 180``.
+
+    Returns
+    -------
+    Panorama
+        ``Panorama(image, elev_top_deg=90, elev_bottom_deg=-90, azimuth0_deg=...)``;
+        the image is not copied.
+    """
+    return Panorama(image, elev_top_deg=90.0, elev_bottom_deg=-90.0, azimuth0_deg=azimuth0_deg)
+
+
+# ------------------------------------------------------------------------ render_view
+
+
+@functools.lru_cache(maxsize=32)
+def _ray_grid(
+    focal: float, pitch_deg: float, cx: float, cy: float, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth offset from the yaw and elevation (degrees) of every pixel's ray."""
+    x = (np.arange(width, dtype=float) - cx) / focal  # right
+    y_up = (cy - np.arange(height, dtype=float)) / focal  # up
+    theta = math.radians(pitch_deg)
+    forward = (math.cos(theta) - math.sin(theta) * y_up)[:, None]
+    up = (math.sin(theta) + math.cos(theta) * y_up)[:, None]
+    left = -x[None, :]
+    az_offset = np.degrees(np.arctan2(left, forward))
+    elevation = np.degrees(np.arctan2(up, np.hypot(forward, left)))
+    elevation = np.broadcast_to(elevation, az_offset.shape).copy()
+    az_offset.flags.writeable = False
+    elevation.flags.writeable = False
+    return az_offset, elevation
+
+
+@functools.lru_cache(maxsize=64)
+def render_view(
+    pano: Panorama,
+    camera: Camera,
+    width: int = 208,
+    height: int = 160,
+    *,
+    illumination: float = 1.0,
+    interpolation: int = cv2.INTER_LINEAR,
+) -> np.ndarray:
+    """Render the pinhole view ``camera`` sees inside panorama ``pano``.
+
+    Every output pixel ``(u, v)`` gets the camera ray of the module conventions
+    (``x = (u - cx) / f`` right, ``y_up = (cy - v) / f`` up, pitched by
+    ``camera.pitch_deg``), whose azimuth ``camera.yaw_deg + atan2(left, forward)`` and
+    elevation ``atan2(up, hypot(forward, left))`` are looked up in the panorama at
+    column ``(azimuth0 - azimuth) W / 360 - 0.5`` (wrapping around 360°) and row
+    ``(elev_top - elevation) H / (elev_top - elev_bottom) - 0.5``. Rays above or below
+    the panorama's elevation band get its top or bottom row (edge replication).
+
+    Parameters
+    ----------
+    pano : Panorama
+        The scene.
+    camera : Camera
+        Horizontal field of view, yaw (optical axis direction, degrees CCW), pitch
+        (positive up) and optional principal point.
+    width, height : int
+        Size of the rendered image, ``>= 2``. The Aibo camera is 208 x 160.
+    illumination : float
+        Scale of the linear-light intensity, ``> 0``: the rendered sRGB values are
+        converted to linear light, multiplied, converted back and clipped (0.5 = half
+        the light; values above 1 saturate). Applied after sampling.
+    interpolation : int
+        ``cv2.INTER_NEAREST``, ``cv2.INTER_LINEAR`` (default), ``cv2.INTER_CUBIC`` or
+        ``cv2.INTER_LANCZOS4``. No anti-aliasing filter is applied: when the panorama
+        has much finer angular resolution than the view, fine texture aliases, as in a
+        real camera without optical low-pass.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(height, width, 3)`` ``uint8`` RGB image.
+
+    Raises
+    ------
+    ValueError
+        On a size below 2, a non-finite or non-positive illumination, an unsupported
+        interpolation, or a panorama side of 32767 pixels or more (a ``cv2.remap``
+        limit; downscale the panorama first).
+    TypeError
+        If ``pano`` is not a :class:`Panorama` or ``camera`` not a ``Camera``.
+    """
+    if not isinstance(pano, Panorama):
+        raise TypeError(f"pano must be a Panorama, got {type(pano).__name__}")
+    if not isinstance(camera, Camera):
+        raise TypeError(f"camera must be a Camera, got {type(camera).__name__}")
+    width = _int_at_least("width", width, 2)
+    height = _int_at_least("height", height, 2)
+    illum = _finite("illumination", illumination)
+    if illum <= 0.0:
+        raise ValueError(f"illumination must be > 0, got {illumination!r}")
+    if (
+        isinstance(interpolation, bool)
+        or not isinstance(interpolation, Integral)
+        or interpolation not in _VERTICAL_PAD
+    ):
+        raise ValueError(
+            "interpolation must be cv2.INTER_NEAREST, INTER_LINEAR, INTER_CUBIC or "
+            f"INTER_LANCZOS4, got {interpolation!r}"
+        )
+    pw, ph = pano.width, pano.height
+    interpolation = int(interpolation)
+    pad = _VERTICAL_PAD[interpolation]
+    if pw > _REMAP_MAX_SIDE or ph + 2 * pad > _REMAP_MAX_SIDE:
+        raise ValueError(
+            f"panorama of {pw}x{ph} pixels is too large for cv2.remap (sides must be < 32767)"
+            "; downscale it first"
+        )
+
+    cx, cy = camera.center(width, height)
+    az_offset, elevation = _ray_grid(
+        float(camera.focal_px(width)),
+        float(camera.pitch_deg),
+        float(cx),
+        float(cy),
+        width,
+        height,
+    )
+    # column = (azimuth0 - yaw - offset) W / 360 - 0.5, wrapped into [0, W)
+    shift = math.fmod(pano.azimuth0_deg - float(camera.yaw_deg), 360.0)
+    scale = pw / 360.0
+    map_x = np.mod((shift - az_offset) * scale - 0.5, pw).astype(np.float32)
+    span = pano.elev_top_deg - pano.elev_bottom_deg
+    map_y = (pano.elev_top_deg - elevation) * (ph / span) - 0.5
+    np.clip(map_y, 0.0, ph - 1.0, out=map_y)  # vertical clamp = edge replication
+
+    src = np.ascontiguousarray(pano.image)
+    if pad:
+        # the kernel reaches `pad` rows beyond the clamped position: replicate them
+        src = cv2.copyMakeBorder(src, pad, pad, 0, 0, cv2.BORDER_REPLICATE)
+        map_y += pad
+    # BORDER_WRAP wraps both axes; vertically the clamp above keeps every tap inside
+    # (linear interpolation at the last row gives the wrapped row a weight of exactly 0)
+    out = cv2.remap(
+        src,
+        map_x,
+        map_y.astype(np.float32),
+        interpolation,
+        borderMode=cv2.BORDER_WRAP,
+    )
+    if illum != 1.0:
+        out = cv2.LUT(out, gain_table(illum))
+    return out
+
+
+# ---------------------------------------------------------------------- make_panorama
+
+
+def _hsv(h: float, s: float, v: float) -> np.ndarray:
+    """RGB colour (float32, 0..255) from hue (turns, wrapped), saturation and value."""
+    r, g, b = colorsys.hsv_to_rgb(h % 1.0, min(max(s, 0.0), 1.0), min(max(v, 0.0), 1.0))
+    return np.array([r, g, b], dtype=np.float32) * np.float32(255.0)
+
+
+def _random_colour(rng: np.random.Generator) -> np.ndarray:
+    """A colour of varied hue, saturation and brightness."""
+    return _hsv(rng.uniform(), rng.uniform(0.15, 0.9), rng.uniform(0.25, 0.95))
+
+
+def _smoothstep(t: np.ndarray) -> np.ndarray:
+    return t * t * (3.0 - 2.0 * t)
+
+
+def _noise_2d(
+    rng: np.random.Generator, width: int, height: int, cells_x: int, cells_y: int
+) -> np.ndarray:
+    """Smooth value noise in [-1, 1], shape ``(height, width)``, periodic in x."""
+    knots = rng.uniform(-1.0, 1.0, (cells_y + 1, cells_x)).astype(np.float32)
+    tx = (np.arange(width) + 0.5) * (cells_x / width)
+    i0 = np.floor(tx).astype(np.intp)
+    wx = _smoothstep(tx - i0).astype(np.float32)
+    rows = knots[:, i0 % cells_x] * (1.0 - wx) + knots[:, (i0 + 1) % cells_x] * wx
+    ty = (np.arange(height) + 0.5) * (cells_y / height)
+    j0 = np.floor(ty).astype(np.intp)
+    wy = _smoothstep(ty - j0).astype(np.float32)[:, None]
+    return rows[j0] * (1.0 - wy) + rows[np.minimum(j0 + 1, cells_y)] * wy
+
+
+class _Canvas:
+    """Float RGB image indexed by azimuth/elevation, painted with wrap-around columns."""
+
+    def __init__(self, azimuth: np.ndarray, elevation: np.ndarray) -> None:
+        self.az = azimuth  # (W,) degrees in [0, 360)
+        self.el = elevation  # (H,) degrees, decreasing
+        self.img = np.zeros((elevation.size, azimuth.size, 3), dtype=np.float32)
+
+    def columns(self, centre: float, half_width: float) -> tuple[np.ndarray, np.ndarray]:
+        """Column indices within ``half_width`` of azimuth ``centre`` (modular), and the
+        signed azimuth of each relative to the centre (positive = left/CCW)."""
+        rel = np.asarray(wrap180(self.az - centre))
+        cols = np.flatnonzero(np.abs(rel) <= half_width)
+        return cols, rel[cols]
+
+    def paint(self, cols: np.ndarray, mask: np.ndarray, colour: np.ndarray) -> None:
+        """Set the pixels ``mask`` (shape ``(H, len(cols))``) of columns ``cols``."""
+        if cols.size == 0:
+            return
+        mask = np.broadcast_to(mask, (self.el.size, cols.size))
+        if not mask.any():
+            return
+        if cols[-1] - cols[0] == cols.size - 1:  # contiguous: paint through a view
+            self.img[:, cols[0] : cols[-1] + 1][mask] = colour
+            return
+        block = self.img[:, cols]  # straddles the seam: gather, paint, scatter
+        block[mask] = colour
+        self.img[:, cols] = block
+
+
+def _free_spot(
+    rng: np.random.Generator,
+    occupied: list[tuple[float, float]],
+    half_width: float,
+    tries: int = 25,
+) -> float | None:
+    """A centre azimuth whose interval does not overlap the ``occupied`` ones."""
+    for _ in range(tries):
+        c = float(rng.uniform(0.0, 360.0))
+        if all(abs(wrap180(c - oc)) > half_width + ohw + 1.0 for oc, ohw in occupied):
+            return c
+    return None
+
+
+def _draw_room(rng: np.random.Generator, canvas: _Canvas) -> None:
+    """An indoor room seen by a low camera (a robot dog) in a rectangular room."""
+    az, el = canvas.az, canvas.el
+    height, width = el.size, az.size
+    img = canvas.img
+
+    # --- geometry (metres): rectangular room, camera at (cam_x, cam_y, cam_h)
+    size_x, size_y = rng.uniform(3.5, 7.0, 2)
+    cam_x = rng.uniform(0.3, 0.7) * size_x
+    cam_y = rng.uniform(0.3, 0.7) * size_y
+    cam_h = rng.uniform(0.2, 0.45)
+    room_h = rng.uniform(2.5, 3.0)
+    phi = np.radians(az)
+    c, s = np.cos(phi), np.sin(phi)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tx = np.where(c > 1e-12, (size_x - cam_x) / c, np.where(c < -1e-12, -cam_x / c, np.inf))
+        ty = np.where(s > 1e-12, (size_y - cam_y) / s, np.where(s < -1e-12, -cam_y / s, np.inf))
+    dist = np.minimum(tx, ty)  # horizontal distance to the wall in each column
+    # azimuths of the four corners: nothing is hung across a corner
+    corners = [
+        (math.degrees(math.atan2(y - cam_y, x - cam_x)), 0.0)
+        for x in (0.0, size_x)
+        for y in (0.0, size_y)
+    ]
+    wall = np.where(tx <= ty, np.where(c > 0, 0, 2), np.where(s > 0, 1, 3))
+    tan_e = np.tan(np.radians(el)).astype(np.float32)
+    # height at which each pixel's ray meets the wall plane of its column
+    z = np.float32(cam_h) + dist.astype(np.float32)[None, :] * tan_e[:, None]
+
+    # --- walls: one paint, lit differently per wall (the corners become vertical edges)
+    wall_rgb = _hsv(rng.uniform(), rng.uniform(0.05, 0.4), rng.uniform(0.65, 0.92))
+    light = rng.uniform(0.72, 1.05, 4).astype(np.float32)[wall]
+    img[:] = wall_rgb * light[None, :, None]
+    img *= (1.0 + 0.04 * _noise_2d(rng, width, height, 60, 15))[:, :, None]
+
+    # --- baseboard
+    base_h = rng.uniform(0.06, 0.12)
+    base_rgb = _hsv(rng.uniform(), rng.uniform(0.0, 0.3), rng.uniform(0.2, 0.95))
+    img[(z >= 0) & (z < base_h)] = base_rgb * 0.95
+
+    # --- floor: carpet (green or grey) with coarse texture, maybe a rug
+    if rng.uniform() < 0.55:
+        carpet = _hsv(rng.uniform(0.22, 0.42), rng.uniform(0.2, 0.55), rng.uniform(0.3, 0.6))
+    else:
+        carpet = _hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.3, 0.65))
+    r0 = int(np.searchsorted(-el, 0.0, side="right"))  # first row below the horizon
+    rows = slice(r0, height)  # every floor pixel is in these rows
+    n_rows = height - r0
+    tex = 0.10 * _noise_2d(rng, width, n_rows, 72, 9) + 0.05 * _noise_2d(
+        rng, width, n_rows, 180, 22
+    )
+    floor_img = carpet[None, None, :] * (1.0 + tex)[:, :, None]
+    np.copyto(img[rows], floor_img, where=(z[rows] < 0)[:, :, None])
+    if rng.uniform() < 0.7:
+        ground_dist = cam_h / -tan_e[rows]  # horizontal distance of each floor row
+        gx = cam_x + ground_dist[:, None] * c[None, :].astype(np.float32)
+        gy = cam_y + ground_dist[:, None] * s[None, :].astype(np.float32)
+        rx, ry = rng.uniform(0.25, 0.75) * size_x, rng.uniform(0.25, 0.75) * size_y
+        hx = rng.uniform(0.5, min(1.5, 0.45 * size_x))
+        hy = rng.uniform(0.5, min(1.5, 0.45 * size_y))
+        border = rng.uniform(0.1, 0.25)
+        outer = (np.abs(gx - rx) < hx) & (np.abs(gy - ry) < hy)
+        inner = (np.abs(gx - rx) < hx - border) & (np.abs(gy - ry) < hy - border)
+        floor = z[rows] < 0
+        img[rows][outer & floor] = _random_colour(rng)
+        img[rows][inner & floor] = _random_colour(rng)
+
+    # --- things on the walls. Floor-standing items stay below 0.95 m, wall-mounted
+    # ones above 1.0 m; doors and bookcases take both layers.
+    low: list[tuple[float, float]] = []
+    high: list[tuple[float, float]] = []
+    n_items = int(rng.integers(10, 17))
+    kinds = rng.choice(
+        ["door", "bookcase", "window", "cabinet", "table", "poster"],
+        size=n_items,
+        p=[0.12, 0.12, 0.16, 0.16, 0.14, 0.30],
+    )
+    order = {"door": 0, "bookcase": 1, "window": 2, "cabinet": 3, "table": 4, "poster": 5}
+    for kind in sorted(kinds, key=order.__getitem__):
+        hw = rng.uniform(5.0, 40.0) / 2.0
+        layers = {"door": (low, high), "bookcase": (low, high), "window": (high,),
+                  "poster": (high,), "cabinet": (low,), "table": (low,)}[kind]  # fmt: skip
+        centre = _free_spot(rng, corners + [o for layer in layers for o in layer], hw)
+        if centre is None:
+            continue
+        for layer in layers:
+            layer.append((centre, hw))
+        cols, rel = canvas.columns(centre, hw)
+        zb = z[:, cols]
+        u = rel / hw  # -1 (right edge) .. 1 (left edge)
+        # approximate width in metres (exact for a wall facing the camera)
+        d_centre = float(dist[cols[np.argmin(np.abs(rel))]])
+        width_m = 2.0 * d_centre * math.tan(math.radians(hw))
+        wall_cols = wall_rgb * light[cols][:, None]
+        _draw_room_item(rng, canvas, kind, cols, u, hw, zb, wall_cols, room_h, width_m)
+
+    # --- ceiling
+    ceiling_rgb = _hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.82, 0.96))
+    ceiling = z[:r0] > room_h  # only rows above the horizon can see the ceiling
+    if ceiling.any():
+        rows = slice(0, int(np.flatnonzero(ceiling.any(axis=1))[-1]) + 1)
+        # a little darker towards the far walls
+        shade = 1.0 - 0.1 * dist[None, :] / (1.0 + dist[None, :])
+        shade = shade * (1.0 - 0.06 * _noise_2d(rng, width, rows.stop, 36, 4))
+        ceiling_img = ceiling_rgb[None, None, :] * shade.astype(np.float32)[:, :, None]
+        np.copyto(img[rows], ceiling_img, where=ceiling[rows][:, :, None])
+
+
+def _draw_room_item(
+    rng: np.random.Generator,
+    canvas: _Canvas,
+    kind: str,
+    cols: np.ndarray,
+    u: np.ndarray,
+    hw: float,
+    zb: np.ndarray,
+    wall_cols: np.ndarray,
+    room_h: float,
+    width_m: float,
+) -> None:
+    """Paint one door / bookcase / window / cabinet / table / poster on the wall.
+
+    ``u`` is the column position across the item (-1 right edge .. 1 left edge), ``hw``
+    its angular half-width and ``zb`` the wall height each pixel of its columns sees.
+    """
+    au = np.abs(u)[None, :]
+
+    def inside(frac: float, min_deg: float = 0.6) -> np.ndarray:
+        """Columns inside a border of ``frac`` of the half-width, at least ``min_deg``
+        wide (thinner vertical bars would alias in a 208-pixel camera)."""
+        return au < 1.0 - max(frac, min_deg / hw)
+
+    def band(z0: float, z1: float) -> np.ndarray:
+        return (zb >= z0) & (zb < z1)
+
+    if kind == "door":
+        top = rng.uniform(1.9, 2.15)
+        if rng.uniform() < 0.5:
+            leaf = _hsv(rng.uniform(0.05, 0.11), rng.uniform(0.4, 0.75), rng.uniform(0.3, 0.65))
+        else:
+            leaf = _random_colour(rng)
+        casing = _hsv(rng.uniform(), rng.uniform(0.0, 0.15), rng.uniform(0.75, 0.95))
+        canvas.paint(cols, band(0.0, top + 0.08), casing)
+        canvas.paint(cols, band(0.0, top) & inside(0.12), leaf)
+    elif kind == "bookcase":
+        top = rng.uniform(1.3, 2.0)
+        frame = _random_colour(rng)
+        canvas.paint(cols, band(0.0, top), frame)
+        n_shelves = int(rng.integers(3, 6))
+        board = rng.uniform(0.04, 0.07)
+        edges = np.linspace(0.08, top - board, n_shelves + 1)
+        interior = frame * rng.uniform(0.3, 0.5)
+        for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+            lo_in, hi_in = lo + board, hi
+            canvas.paint(cols, band(lo_in, hi_in) & inside(0.1), interior)
+            # a few coarse blocks of "books"/boxes per compartment
+            x = 0.9
+            while x > -0.9:
+                w = rng.uniform(max(0.3, 1.0 / hw), 0.9)  # at least 0.5° wide
+                if rng.uniform() < 0.7:
+                    book_top = lo_in + rng.uniform(0.55, 0.95) * (hi_in - lo_in)
+                    m = band(lo_in, book_top) & (u[None, :] <= x) & (u[None, :] > x - w)
+                    canvas.paint(cols, m & inside(0.1), _random_colour(rng))
+                x -= w
+    elif kind == "window":
+        z0, z1 = rng.uniform(1.0, 1.2), min(rng.uniform(2.0, 2.3), room_h - 0.15)
+        frame = _hsv(rng.uniform(), rng.uniform(0.0, 0.12), rng.uniform(0.8, 0.97))
+        canvas.paint(cols, band(z0, z1), frame)
+        t = np.clip((zb - z0) / (z1 - z0), 0.0, 1.0)
+        hue = rng.uniform(0.52, 0.62)
+        lower = _hsv(hue, rng.uniform(0.05, 0.25), rng.uniform(0.75, 0.9))
+        upper = _hsv(hue, rng.uniform(0.2, 0.5), rng.uniform(0.85, 1.0))
+        mullion = max(0.07, 0.5 / hw)
+        pane_mask = band(z0 + 0.06, z1 - 0.06) & inside(0.1) & (au > mullion)
+        if pane_mask.any():
+            block = canvas.img[:, cols]
+            sky = lower[None, None, :] * (1 - t[:, :, None]) + upper[None, None, :] * t[:, :, None]
+            block[pane_mask] = sky[pane_mask]
+            canvas.img[:, cols] = block
+        if rng.uniform() < 0.6:  # curtains on both sides
+            curtain = _random_colour(rng)
+            canvas.paint(cols, band(z0 - 0.25, z1 + 0.1) & ~inside(0.22, 1.0), curtain)
+    elif kind == "cabinet":
+        top = rng.uniform(0.45, 0.95)
+        body = _random_colour(rng)
+        slab = body * rng.uniform(0.55, 0.8) if rng.uniform() < 0.5 else _random_colour(rng)
+        canvas.paint(cols, band(0.0, top), body)
+        canvas.paint(cols, band(top - rng.uniform(0.04, 0.08), top), slab)
+        canvas.paint(cols, band(0.0, 0.07), body * 0.4)  # plinth shadow
+    elif kind == "table":
+        top = rng.uniform(0.6, 0.8)
+        wood = _random_colour(rng)
+        thick = rng.uniform(0.05, 0.09)
+        shadow = wall_cols[None, :, :] * np.float32(rng.uniform(0.45, 0.65))
+        under = band(0.0, top - thick)
+        if under.any():
+            block = canvas.img[:, cols]
+            block[under] = np.broadcast_to(shadow, block.shape)[under]
+            canvas.img[:, cols] = block
+        canvas.paint(cols, band(top - thick, top), wood)
+        canvas.paint(cols, band(0.0, top) & ~inside(0.14, 0.8), wood * 0.8)  # legs
+    else:  # poster / painting
+        z0 = rng.uniform(1.05, 1.5)
+        z1 = min(z0 + max(rng.uniform(0.5, 1.2) * width_m, 0.25), room_h - 0.2)
+        outer = _random_colour(rng)
+        canvas.paint(cols, band(z0, z1), outer)
+        inset = rng.uniform(0.08, 0.2)
+        dz = inset * (z1 - z0)
+        inner = band(z0 + dz, z1 - dz) & inside(inset)
+        canvas.paint(cols, inner, _random_colour(rng))
+        if rng.uniform() < 0.5:  # two-tone picture (a "landscape")
+            split = z0 + dz + rng.uniform(0.3, 0.6) * (z1 - z0 - 2 * dz)
+            canvas.paint(cols, inner & (zb < split), _random_colour(rng))
+
+
+def _draw_outdoor(rng: np.random.Generator, canvas: _Canvas) -> None:
+    """Sky, distant hills, buildings and trees on the horizon, grass below."""
+    az, el = canvas.az, canvas.el
+    height, width = el.size, az.size
+    img = canvas.img
+    phi = np.radians(az)
+
+    # --- sky: gradient from a pale horizon to a deeper zenith, soft coarse clouds
+    hue = rng.uniform(0.54, 0.63)
+    horizon = _hsv(hue + rng.uniform(-0.03, 0.03), rng.uniform(0.08, 0.25), rng.uniform(0.85, 0.97))
+    zenith = _hsv(hue, rng.uniform(0.45, 0.75), rng.uniform(0.65, 0.9))
+    t = (np.clip(el / 45.0, 0.0, 1.0) ** 0.6).astype(np.float32)[:, None, None]
+    img[:] = horizon * (1.0 - t) + zenith * t
+    clouds = _noise_2d(rng, width, height, 24, 8) + 0.5 * _noise_2d(rng, width, height, 60, 20)
+    cover = np.clip((clouds - rng.uniform(0.1, 0.6)) / 0.35, 0.0, 1.0)
+    cover *= np.clip((el - 2.0) / 10.0, 0.0, 1.0).astype(np.float32)[:, None]
+    cloud_rgb = _hsv(hue, 0.03, rng.uniform(0.9, 1.0))
+    img += (cloud_rgb - img) * cover[:, :, None]
+
+    # --- grass below the horizon: darker and hazier far away, coarse patches
+    g_hue, g_sat = rng.uniform(0.2, 0.32), rng.uniform(0.4, 0.7)
+    near = _hsv(g_hue, g_sat, rng.uniform(0.5, 0.7))
+    far = _hsv(g_hue + 0.02, g_sat * 0.6, rng.uniform(0.4, 0.55))
+    ground = el < 0
+    tg = (np.clip(-el / 45.0, 0.0, 1.0) ** 0.5).astype(np.float32)[ground][:, None, None]
+    patches = 0.12 * _noise_2d(rng, width, int(ground.sum()), 48, 10) + 0.05 * _noise_2d(
+        rng, width, int(ground.sum()), 150, 30
+    )
+    img[ground] = (far * (1.0 - tg) + near * tg) * (1.0 + patches)[:, :, None]
+
+    # --- distant hills: periodic ridge line (seamless by construction)
+    k = np.arange(1, 7)
+    amp = rng.uniform(0.3, 1.0, k.size) * 3.0 / k
+    ph = rng.uniform(0.0, 2 * np.pi, k.size)
+    ridge = rng.uniform(2.5, 6.0) + (amp[:, None] * np.sin(k[:, None] * phi + ph[:, None])).sum(0)
+    ridge = np.maximum(ridge, 0.5).astype(np.float32)
+    hill_rgb = 0.55 * far + 0.45 * horizon * rng.uniform(0.7, 0.9)
+    hills = (el[:, None] >= 0) & (el[:, None] < ridge[None, :])
+    img[hills] = hill_rgb
+
+    # --- buildings: blocks with a darker roof, a shaded side, maybe big windows
+    occupied: list[tuple[float, float]] = []
+    for _ in range(int(rng.integers(3, 8))):
+        hw = rng.uniform(5.0, 40.0) / 2.0
+        centre = _free_spot(rng, occupied, hw)
+        if centre is None:
+            continue
+        occupied.append((centre, hw))
+        cols, rel = canvas.columns(centre, hw)
+        u = (rel / hw)[None, :]
+        top = rng.uniform(4.0, 22.0)
+        base = -rng.uniform(0.0, 1.0)
+        e = el[:, None]
+        body = _hsv(rng.uniform(), rng.uniform(0.05, 0.45), rng.uniform(0.4, 0.85))
+        canvas.paint(cols, (e >= base) & (e < top) & (u >= 0), body)
+        canvas.paint(cols, (e >= base) & (e < top) & (u < 0), body * rng.uniform(0.6, 0.8))
+        roof_h = rng.uniform(0.1, 0.2) * (top - base)
+        canvas.paint(cols, (e >= top - roof_h) & (e < top), _random_colour(rng) * 0.6)
+        if top - base > 9.0 and hw > 6.0 and rng.uniform() < 0.7:
+            glass = _hsv(rng.uniform(0.5, 0.65), rng.uniform(0.2, 0.5), rng.uniform(0.2, 0.45))
+            cell_e, cell_a = rng.uniform(3.5, 5.0), rng.uniform(4.5, 7.0)
+            fe = np.mod(e - base, cell_e) / cell_e  # position within a window cell
+            fa = np.mod(rel[None, :] + hw, cell_a) / cell_a
+            m = (fe > 0.35) & (fe < 0.8) & (fa > 0.25) & (fa < 0.75)
+            m &= (e > base + 1.0) & (e < top - roof_h - 0.8) & (np.abs(u) < 0.88)
+            canvas.paint(cols, m, glass)
+
+    # --- trees: round or conical crowns on trunks, some in front of the horizon
+    for _ in range(int(rng.integers(8, 19))):
+        hw = rng.uniform(2.0, 8.0)
+        centre = float(rng.uniform(0.0, 360.0))
+        cols, rel = canvas.columns(centre, hw)
+        base = -rng.uniform(0.0, 3.0)
+        crown_h = hw * rng.uniform(1.0, 1.6)
+        trunk = crown_h * rng.uniform(0.3, 0.7)
+        e = el[:, None]
+        a = rel[None, :]
+        canvas.paint(
+            cols,
+            (np.abs(a) < max(0.16 * hw, 0.4)) & (e >= base) & (e < base + trunk + crown_h),
+            _hsv(rng.uniform(0.05, 0.1), rng.uniform(0.4, 0.7), rng.uniform(0.2, 0.4)),
+        )
+        leaves = _hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.85), rng.uniform(0.18, 0.5))
+        bottom = base + trunk
+        if rng.uniform() < 0.6:  # round crown
+            ce = bottom + crown_h / 2.0
+            m = (a / hw) ** 2 + ((e - ce) / (crown_h / 2.0)) ** 2 <= 1.0
+        else:  # conifer
+            m = (e >= bottom) & (np.abs(a) <= hw * (1.0 - (e - bottom) / (1.6 * crown_h)))
+        canvas.paint(cols, m, leaves)
+
+    # --- bushes, rocks and flower beds in the foreground (flat-bottomed mounds)
+    for _ in range(int(rng.integers(3, 8))):
+        hw = rng.uniform(4.0, 15.0)
+        cols, rel = canvas.columns(float(rng.uniform(0.0, 360.0)), hw)
+        ce, he = rng.uniform(-30.0, -4.0), rng.uniform(2.0, 7.0)
+        m = ((rel[None, :] / hw) ** 2 + ((el[:, None] - ce) / he) ** 2 <= 1.0) & (el[:, None] >= ce)
+        if rng.uniform() < 0.5:
+            colour = _hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.8), rng.uniform(0.2, 0.45))
+        else:
+            colour = _random_colour(rng)
+        canvas.paint(cols, m, colour)
+
+
+def make_panorama(
+    rng: np.random.Generator,
+    width: int = 3600,
+    height: int = 900,
+    *,
+    kind: str = "room",
+    noise: float = 4.0,
+) -> Panorama:
+    """Paint a procedural, seamless 360° panorama.
+
+    The scene is coarse (large uniform regions and straight or smoothly curved edges,
+    no fine stripes that a 208 x 160 camera would alias) and depends only on ``rng``;
+    the global ``numpy.random`` state is neither used nor changed. All features are
+    drawn with modular column indices, so they may straddle the 0/360 seam without a
+    discontinuity.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of all randomness (``np.random.default_rng(seed)``).
+    width, height : int
+        Panorama size; ``width >= 360``, ``height >= 90``. The image covers 360° of
+        azimuth and elevations +45° (top) to -45° (bottom), so the default 3600 x 900
+        has 10 pixels per degree; column 0 starts at azimuth 0 and azimuth decreases to
+        the right (see the module conventions).
+    kind : {"room", "outdoor"}
+        ``"room"``: the inside of a rectangular room seen from a low camera: carpet
+        floor below the horizon (maybe with a rug), walls lit differently per wall
+        with a baseboard, doors, windows, bookcases, cabinets, tables and posters
+        (5°-40° wide, random colours and heights), and the ceiling near the top.
+        ``"outdoor"``: sky gradient with soft clouds, distant hills, building and tree
+        silhouettes of random heights on the horizon, grass with bushes below.
+    noise : float
+        Standard deviation (grey levels) of per-pixel Gaussian noise, ``>= 0``. The
+        noise is drawn last, so the same seed gives the same scene for any noise.
+
+    Returns
+    -------
+    Panorama
+        ``uint8`` RGB image, ``elev_top_deg=45``, ``elev_bottom_deg=-45``,
+        ``azimuth0_deg=0``.
+
+    Raises
+    ------
+    ValueError
+        On a bad size, kind or noise level.
+    TypeError
+        If ``rng`` is not a ``numpy.random.Generator``.
+    """
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError(
+            f"rng must be a numpy.random.Generator (np.random.default_rng(seed)), got "
+            f"{type(rng).__name__}"
+        )
+    width = _int_at_least("width", width, 360)
+    height = _int_at_least("height", height, 90)
+    if kind not in PANORAMA_KINDS:
+        raise ValueError(f"kind must be one of {PANORAMA_KINDS}, got {kind!r}")
+    sigma = _finite("noise", noise)
+    if sigma < 0.0:
+        raise ValueError(f"noise must be >= 0, got {noise!r}")
+
+    top, bottom, azimuth0 = 45.0, -45.0, 0.0
+    azimuth = np.asarray(wrap360(azimuth0 - 360.0 * (np.arange(width) + 0.5) / width))
+    elevation = top - (top - bottom) * (np.arange(height) + 0.5) / height
+    canvas = _Canvas(azimuth, elevation.astype(np.float32))
+    if kind == "room":
+        _draw_room(rng, canvas)
+    else:
+        _draw_outdoor(rng, canvas)
+    img = canvas.img
+    img *= (1.0 + 0.05 * _noise_2d(rng, width, height, 36, 9))[:, :, None]  # soft lighting
+    if sigma > 0.0:
+        img += rng.standard_normal(img.shape, dtype=np.float32) * np.float32(sigma)
+    np.clip(img, 0.0, 255.0, out=img)
+    np.rint(img, out=img)
+    return Panorama(img.astype(np.uint8), top, bottom, azimuth0)

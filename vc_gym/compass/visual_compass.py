@@ -1,0 +1,575 @@
+"""The visual compass sensor model of Sturm & Visser (paper sections 3.1-3.4).
+
+A :class:`VisualCompass` learns, at one spot, how often each colour-class transition
+appears in each direction (a histogram map, eq. 1-2 and 6) and answers, for a new
+camera image, a log-likelihood for every candidate heading (eq. 5, 15-16).
+"""
+
+from __future__ import annotations
+
+import os
+from collections import OrderedDict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from vc_gym.angles import circular_std, wrap360
+from vc_gym.compass.camera import Camera
+from vc_gym.compass.colors import ColorClasses
+from vc_gym.compass.config import CompassConfig
+from vc_gym.compass.exposure import gain_table, mean_linear_level
+from vc_gym.compass.features import ScanGrid, column_transition_counts, log2_bin, scan_grid
+from vc_gym.errors import MapFileError, NotLearnedError
+from vc_gym.images import check_image
+from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
+
+__all__ = ["VisualCompass", "CompassEstimate"]
+
+MAP_SCHEMA = "vc_gym.VisualCompass"
+MAP_SCHEMA_VERSION = 1
+#: Pseudo-count per bin of the heading-independent (pooled) histogram.
+_POOL_PSEUDOCOUNT = 0.5
+_CACHE_SIZE = 16
+
+
+@dataclass(frozen=True)
+class CompassEstimate:
+    """What the compass says about one image.
+
+    Attributes
+    ----------
+    heading_deg : float
+        Most likely heading in ``[0, 360)`` (arg-max of the log-likelihood, refined
+        between grid points by a parabola through the peak and its neighbours).
+    spread_deg : float
+        Circular standard deviation (eq. 27) of the posterior ``∝ exp(log-likelihood)``
+        under a uniform prior. Small when one heading clearly wins, large (up to
+        infinity) when the image is ambiguous.
+    score : float
+        Goodness of fit: the mean log-probability per term (sector × class pair) of
+        the image's features under the map at the best heading, ``<= 0``. It is
+        comparable between maps with the same config, so it serves as the per-spot
+        goodness ``L`` of eq. 28 (``exp(score)`` is the geometric-mean likelihood
+        per term).
+    n_sectors : int
+        Number of sectors the image contributed (about ``hfov / sector_deg``).
+    log_likelihood : numpy.ndarray
+        The full log-likelihood over :attr:`VisualCompass.headings_deg`.
+    """
+
+    heading_deg: float
+    spread_deg: float
+    score: float
+    n_sectors: int
+    log_likelihood: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """Everything about an image size + camera that does not depend on pixel values."""
+
+    grid: ScanGrid
+    row_slice: slice
+    col_slice: slice
+    assign: np.ndarray  # (P*K, U) float32: column u belongs to relative sector k at phase p
+    kmin: int
+    n_rel: int  # K
+    heading_phase: np.ndarray  # (n_headings,) phase index of each heading
+    heading_sector: np.ndarray  # (n_headings,) sector of each heading's optical axis
+    roll_index: np.ndarray  # (K, S): sector (s0 + k + kmin) mod S
+
+
+class VisualCompass:
+    """Appearance-based visual compass: learn a map at a spot, then tell headings.
+
+    Parameters
+    ----------
+    config : CompassConfig, optional
+        Parameters; the paper's values by default.
+    colors : ColorClasses, optional
+        Colour classes learned beforehand; otherwise call :meth:`fit_colors`.
+
+    Notes
+    -----
+    The map holds counts ``m[sector, i, j, bin]`` (paper eq. 1, 6) and the number of
+    frames that saw each sector. The likelihood of an image at heading ``φ`` is the
+    product over the sectors in view and over all class pairs (eq. 5, 16) of the
+    smoothed histogram probability of the bin its relative frequency falls in.
+
+    The features of an image depend on the candidate heading (columns are grouped
+    into sectors differently for headings that are not a multiple of the sector
+    width). :meth:`log_likelihood` therefore returns the log of the likelihood
+    *ratio* against the map's heading-independent model (the same histograms pooled
+    over all sectors). It differs from ``log p(image | φ)`` by a term that does not
+    depend on the heading; sectors the map has never seen contribute exactly zero.
+
+    Examples
+    --------
+    >>> vc = VisualCompass(CompassConfig(n_colors=10))          # doctest: +SKIP
+    >>> vc.fit_colors(images)                                   # doctest: +SKIP
+    >>> for img, yaw in training: vc.learn(img, Camera(yaw_deg=yaw))  # doctest: +SKIP
+    >>> vc.estimate(new_image, Camera()).heading_deg            # doctest: +SKIP
+    """
+
+    def __init__(self, config: CompassConfig | None = None, colors: ColorClasses | None = None):
+        self.config = config if config is not None else CompassConfig()
+        if not isinstance(self.config, CompassConfig):
+            raise ValueError(f"config must be a CompassConfig, got {type(self.config).__name__}")
+        self._colors: ColorClasses | None = None
+        if colors is not None:
+            self._set_colors(colors)
+        cfg = self.config
+        c2 = cfg.n_colors**2
+        self._counts = np.zeros((cfg.n_sectors, c2, cfg.n_bins), dtype=np.float64)
+        self._n_obs = np.zeros(cfg.n_sectors, dtype=np.float64)
+        self._frames = 0
+        self._exposure_ref = 0.0  # mean linear level of the colour-fitting images
+        self._sizes: set[tuple[int, int]] = set()  # (H, W) of the learned frames
+        self._tables: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._geom_cache: OrderedDict[tuple, _Geometry] = OrderedDict()
+        h = np.arange(cfg.n_headings, dtype=np.float64) * cfg.heading_step_deg
+        h.setflags(write=False)
+        self._headings = h
+
+    # ------------------------------------------------------------------ properties
+    @property
+    def headings_deg(self) -> np.ndarray:
+        """Candidate headings (read-only), ``0, step, ..., 360 - step`` degrees."""
+        return self._headings
+
+    @property
+    def colors(self) -> ColorClasses | None:
+        """The colour classes, or ``None`` before :meth:`fit_colors`."""
+        return self._colors
+
+    @property
+    def frames_learned(self) -> int:
+        """Number of frames added to the map by :meth:`learn`."""
+        return self._frames
+
+    @property
+    def sector_observations(self) -> np.ndarray:
+        """How many learned frames saw each sector (copy), shape ``(n_sectors,)``."""
+        return self._n_obs.astype(np.int64)
+
+    @property
+    def learned_fraction(self) -> float:
+        """Fraction of the full circle covered by at least one learned frame."""
+        return float(np.mean(self._n_obs > 0))
+
+    @property
+    def is_learned(self) -> bool:
+        """True once colour classes exist and at least one frame was learned."""
+        return self._colors is not None and self._frames > 0
+
+    # ------------------------------------------------------------------ colours
+    def _set_colors(self, colors: ColorClasses) -> None:
+        if not isinstance(colors, ColorClasses):
+            raise ValueError(f"colors must be a ColorClasses, got {type(colors).__name__}")
+        if colors.n_colors != self.config.n_colors:
+            raise ValueError(
+                f"colors has {colors.n_colors} classes but config.n_colors is "
+                f"{self.config.n_colors}"
+            )
+        self._colors = colors
+
+    def fit_colors(
+        self,
+        images: Sequence[np.ndarray],
+        rng: np.random.Generator | None = None,
+        *,
+        reset_map: bool = False,
+        max_samples: int = 20000,
+    ) -> VisualCompass:
+        """Learn the colour classes from sample images (paper 3.4, eq. 7-8).
+
+        Parameters
+        ----------
+        images : sequence of numpy.ndarray
+            ``(H, W, 3)`` uint8 RGB images of the environment.
+        rng : numpy.random.Generator, optional
+            Source of the pixel subsample and k-means++ seeds (default: seed 0).
+        reset_map : bool
+            A learned map is only valid for the classes it was learned with, so
+            refitting the classes of a compass that has learned frames is an error
+            unless ``reset_map=True``, which also clears the map.
+        max_samples : int
+            Pixels used for EM.
+
+        Returns
+        -------
+        VisualCompass
+            ``self``, for chaining.
+        """
+        if self._frames > 0 and not reset_map:
+            raise ValueError(
+                "this compass has already learned a map with its colour classes; "
+                "pass reset_map=True to refit the classes and clear the map"
+            )
+        if isinstance(images, np.ndarray) and images.ndim == 3:
+            images = [images]
+        images = [check_image(im, f"images[{i}]") for i, im in enumerate(images)]
+        if not images:
+            raise ValueError("fit_colors needs at least one image")
+        if self.config.exposure == "mean":
+            # reference level from the upper halves (what the compass scans at pitch 0)
+            levels = [mean_linear_level(im[: max(im.shape[0] // 2, 1)]) for im in images]
+            ref = float(np.mean(levels))
+            if ref <= 0:
+                raise ValueError("exposure='mean' needs colour-fitting images that are not black")
+            images = [
+                self._apply_gain(im[: max(im.shape[0] // 2, 1)], lvl, ref)
+                for im, lvl in zip(images, levels, strict=True)
+            ]
+            self._exposure_ref = ref
+        self._set_colors(
+            ColorClasses.fit(
+                images,
+                n_colors=self.config.n_colors,
+                rng=rng,
+                bits=self.config.lut_bits,
+                max_samples=max_samples,
+            )
+        )
+        if reset_map:
+            self.reset_map()
+        return self
+
+    def reset_map(self) -> None:
+        """Forget every learned frame (keeps the colour classes)."""
+        self._counts[:] = 0
+        self._n_obs[:] = 0
+        self._frames = 0
+        self._sizes.clear()
+        self._tables = None
+
+    # ------------------------------------------------------------------ features
+    def _geometry(self, camera: Camera, width: int, height: int) -> _Geometry:
+        key = (width, height, camera.hfov_deg, camera.pitch_deg, camera.principal_point)
+        geom = self._geom_cache.get(key)
+        if geom is not None:
+            self._geom_cache.move_to_end(key)
+            return geom
+        cfg = self.config
+        row_step, col_step = cfg.grid_steps
+        grid = scan_grid(camera, width, height, row_step, col_step)
+        if grid.rows.size:
+            row_slice = slice(int(grid.rows[0]), int(grid.rows[-1]) + 1, row_step)
+        else:
+            row_slice = slice(0, 0)
+        col_slice = slice(int(grid.cols[0]), width, col_step)
+        delta = cfg.sector_deg
+        s_total = cfg.n_sectors
+        # heading = s0 * delta + phase, 0 <= phase < delta; a column at offset r then
+        # falls into sector s0 + floor((phase + r) / delta)
+        hs = self._headings
+        s0 = np.floor(hs / delta + 1e-9).astype(np.int64)
+        phase = np.round(hs - s0 * delta, 9)
+        phases, heading_phase = np.unique(phase, return_inverse=True)
+        k = np.floor((phases[:, None] + grid.offsets_deg[None, :]) / delta).astype(np.int64)
+        kmin = int(k.min())
+        n_rel = int(k.max()) - kmin + 1
+        n_p, n_u = k.shape
+        assign = np.zeros((n_p * n_rel, n_u), dtype=np.float32)
+        rows = np.arange(n_p)[:, None] * n_rel + (k - kmin)
+        assign[rows.ravel(), np.tile(np.arange(n_u), n_p)] = 1.0
+        roll = (np.arange(s_total)[None, :] + np.arange(n_rel)[:, None] + kmin) % s_total
+        geom = _Geometry(
+            grid=grid,
+            row_slice=row_slice,
+            col_slice=col_slice,
+            assign=assign,
+            kmin=kmin,
+            n_rel=n_rel,
+            heading_phase=heading_phase.astype(np.intp),
+            heading_sector=s0 % s_total,
+            roll_index=roll,
+        )
+        self._geom_cache[key] = geom
+        if len(self._geom_cache) > _CACHE_SIZE:
+            self._geom_cache.popitem(last=False)
+        return geom
+
+    @staticmethod
+    def _apply_gain(pixels: np.ndarray, level: float, ref: float) -> np.ndarray:
+        """Scale linear light so that a frame at ``level`` comes out at ``ref``."""
+        if level <= 0:
+            return pixels
+        return np.take(gain_table(ref / level), pixels)
+
+    def _column_counts(self, image: np.ndarray, geom: _Geometry) -> np.ndarray:
+        assert self._colors is not None
+        pixels = image[geom.row_slice, geom.col_slice]
+        if self.config.exposure == "mean":
+            pixels = self._apply_gain(pixels, mean_linear_level(pixels), self._exposure_ref)
+        classes = self._colors.classify_pixels(pixels)
+        return column_transition_counts(classes, self.config.n_colors, self.config.count_same_class)
+
+    def _checked(self, image: np.ndarray, camera: Camera, need_map: bool) -> None:
+        check_image(image)
+        if not isinstance(camera, Camera):
+            raise ValueError(f"camera must be a Camera, got {type(camera).__name__}")
+        if self._colors is None:
+            raise NotLearnedError("no colour classes yet: call fit_colors(images) first")
+        if need_map and self._frames == 0:
+            raise NotLearnedError("the map is empty: learn(image, camera) at least one frame")
+        size = image.shape[:2]
+        if need_map and size not in self._sizes and size[::-1] in self._sizes:
+            raise ValueError(
+                f"image of shape {image.shape} looks transposed: the map was learned from "
+                f"{size[1]}x{size[0]} (HxW) frames; pass (H, W, 3) arrays"
+            )
+
+    # ------------------------------------------------------------------ learning
+    def learn(self, image: np.ndarray, camera: Camera) -> int:
+        """Add one frame seen at the known ``camera.yaw_deg`` to the map (eq. 6).
+
+        Only the sectors in the camera's view are updated: each gets one count in
+        the bin its relative frequency (eq. 11) falls in, for every class pair.
+
+        Returns
+        -------
+        int
+            Number of sectors updated (0 if nothing above the horizon is visible).
+        """
+        self._checked(image, camera, need_map=False)
+        h, w = image.shape[:2]
+        geom = self._geometry(camera, w, h)
+        colcounts = self._column_counts(image, geom)
+        cfg = self.config
+        sector = (
+            np.floor((camera.yaw_deg + geom.grid.offsets_deg) / cfg.sector_deg + 1e-9).astype(
+                np.int64
+            )
+            % cfg.n_sectors
+        )
+        c2 = colcounts.shape[1]
+        flat = (sector[:, None] * c2 + np.arange(c2)[None, :]).ravel()
+        counts = np.bincount(flat, weights=colcounts.ravel(), minlength=cfg.n_sectors * c2).reshape(
+            cfg.n_sectors, c2
+        )
+        total = counts.sum(axis=1)
+        seen = np.flatnonzero(total > 0)
+        if seen.size == 0:
+            return 0
+        z = counts[seen] / total[seen, None]
+        bins = log2_bin(z, cfg.n_bins)
+        self._counts[seen[:, None], np.arange(c2)[None, :], bins] += 1.0
+        self._n_obs[seen] += 1.0
+        self._frames += 1
+        self._sizes.add((h, w))
+        self._tables = None
+        return int(seen.size)
+
+    # ------------------------------------------------------------------ likelihood
+    def _log_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(delta_t, base, log_abs)`` for the current map (cached until it changes).
+
+        ``log_abs[s, ij, b]`` is the smoothed log-probability of bin ``b``;
+        ``ratio = log_abs - log_pool``; ``base[s]`` sums the ratio of the empty bin
+        over all pairs and ``delta_t[ij * n + b, s]`` is the ratio minus that of the
+        empty bin, so that only non-zero frequencies need a table read.
+        """
+        if self._tables is not None:
+            return self._tables
+        cfg = self.config
+        n = cfg.n_bins
+        counts = self._counts
+        pooled = counts.sum(axis=0) + _POOL_PSEUDOCOUNT  # (c2, n)
+        p_pool = pooled / pooled.sum(axis=1, keepdims=True)
+        kappa = cfg.smoothing
+        p_sec = (counts + kappa * p_pool[None]) / (self._n_obs[:, None, None] + kappa)
+        log_abs = np.log(p_sec)
+        ratio = log_abs - np.log(p_pool)[None]
+        last = ratio[:, :, n - 1 : n]
+        base = last[:, :, 0].sum(axis=1)  # (S,)
+        delta = ratio - last  # (S, c2, n)
+        delta_t = np.ascontiguousarray(delta.reshape(delta.shape[0], -1).T)  # (c2*n, S)
+        self._tables = (delta_t, base, log_abs)
+        return self._tables
+
+    def _sector_features(
+        self, image: np.ndarray, camera: Camera
+    ) -> tuple[_Geometry, np.ndarray, np.ndarray]:
+        """Counts per (phase, relative sector, pair) and which of them saw anything."""
+        h, w = image.shape[:2]
+        geom = self._geometry(camera, w, h)
+        colcounts = self._column_counts(image, geom)
+        counts = geom.assign @ colcounts  # (P*K, c2)
+        total = counts.sum(axis=1)
+        return geom, counts, total
+
+    def log_likelihood(self, image: np.ndarray, camera: Camera) -> np.ndarray:
+        """Log-likelihood of every candidate heading for one image (eq. 5, 15-16).
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            ``(H, W, 3)`` uint8 RGB camera image.
+        camera : Camera
+            Intrinsics and pitch of the camera; its ``yaw_deg`` is ignored.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``float64`` array over :attr:`headings_deg`: ``log p(image | φ, m)`` up to
+            a constant that does not depend on ``φ`` (see class notes), divided by
+            ``config.temperature``. All zeros if nothing above the horizon is visible.
+        """
+        self._checked(image, camera, need_map=True)
+        geom, counts, total = self._sector_features(image, camera)
+        delta_t, base, _ = self._log_tables()
+        s_total = self.config.n_sectors
+        n = self.config.n_bins
+        seen = total > 0
+        if not seen.any():
+            return np.zeros(self._headings.size)
+        nz_group, nz_code = np.nonzero(counts)
+        z = counts[nz_group, nz_code] / total[nz_group]
+        rows = nz_code * n + log2_bin(z, n)
+        gathered = np.take(delta_t, rows, axis=0)  # (E, S)
+        starts = np.flatnonzero(np.r_[True, nz_group[1:] != nz_group[:-1]])
+        per_group = np.zeros((counts.shape[0], s_total))
+        per_group[nz_group[starts]] = np.add.reduceat(gathered, starts, axis=0)
+        per_group[seen] += base[None, :]
+        per_group = per_group.reshape(-1, geom.n_rel, s_total)  # (P, K, S) by absolute sector
+        # score[p, s0] = sum_k per_group[p, k, s0 + k + kmin]
+        by_start = per_group[:, np.arange(geom.n_rel)[:, None], geom.roll_index].sum(axis=1)
+        ll = by_start[geom.heading_phase, geom.heading_sector]
+        if self.config.temperature != 1.0:
+            ll = ll / self.config.temperature
+        return ll
+
+    def estimate(self, image: np.ndarray, camera: Camera) -> CompassEstimate:
+        """Best heading, its spread and the goodness of fit for one image.
+
+        See :class:`CompassEstimate` for the meaning of each number (eq. 25-28).
+        """
+        ll = self.log_likelihood(image, camera)
+        geom, counts, total = self._sector_features(image, camera)
+        n_h = ll.size
+        best = int(np.argmax(ll))
+        step = self.config.heading_step_deg
+        y0, y1, y2 = ll[(best - 1) % n_h], ll[best], ll[(best + 1) % n_h]
+        denom = y0 - 2.0 * y1 + y2
+        frac = 0.5 * (y0 - y2) / denom if denom < 0 else 0.0
+        heading = float(wrap360(self._headings[best] + float(np.clip(frac, -0.5, 0.5)) * step))
+        post = np.exp(ll - ll[best])
+        spread = circular_std(self._headings, post)
+        score, n_sectors = self._score_at(geom, counts, total, best)
+        return CompassEstimate(heading, spread, score, n_sectors, ll)
+
+    def _score_at(
+        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray, heading_index: int
+    ) -> tuple[float, int]:
+        """Mean per-term log-probability at one heading and the number of sectors used."""
+        _, _, log_abs = self._log_tables()
+        p = geom.heading_phase[heading_index]
+        s0 = geom.heading_sector[heading_index]
+        k = geom.n_rel
+        c = counts[p * k : (p + 1) * k]
+        t = total[p * k : (p + 1) * k]
+        seen = np.flatnonzero(t > 0)
+        if seen.size == 0:
+            return 0.0, 0
+        z = c[seen] / t[seen, None]
+        bins = log2_bin(z, self.config.n_bins)
+        sectors = (s0 + seen + geom.kmin) % self.config.n_sectors
+        terms = log_abs[sectors[:, None], np.arange(c.shape[1])[None, :], bins]
+        return float(terms.mean()), int(seen.size)
+
+    # ------------------------------------------------------------------ persistence
+    def save(self, path: str | os.PathLike) -> Path:
+        """Save config, colour classes and map to an ``.npz`` file, atomically.
+
+        Returns the path written (``.npz`` appended if missing).
+        """
+        if self._colors is None:
+            raise NotLearnedError("nothing to save: the compass has no colour classes yet")
+        arrays = {
+            "config": json_array(self.config.to_dict()),
+            "counts": self._counts.astype(np.uint32),
+            "sector_observations": self._n_obs.astype(np.uint32),
+            "frames_learned": np.array(self._frames, dtype=np.int64),
+            "exposure_reference": np.array(self._exposure_ref, dtype=np.float64),
+            "learned_sizes": np.array(sorted(self._sizes), dtype=np.int64).reshape(-1, 2),
+            **self._colors.to_arrays(),
+        }
+        return save_npz_atomic(path, MAP_SCHEMA, MAP_SCHEMA_VERSION, arrays)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike, config: CompassConfig | None = None) -> VisualCompass:
+        """Load a compass saved by :meth:`save`.
+
+        Parameters
+        ----------
+        path : path-like
+            The ``.npz`` file.
+        config : CompassConfig, optional
+            If given, the file's config must equal it (guards against mixing maps
+            learned with other parameters).
+
+        Raises
+        ------
+        MapFileError
+            Missing, empty, truncated or corrupt file, another schema or version,
+            or arrays whose shapes do not match the stored config.
+        """
+        arrays = load_npz_checked(path, MAP_SCHEMA, MAP_SCHEMA_VERSION)
+        raw = read_json_array(arrays, "config", path)
+        try:
+            stored = CompassConfig.from_dict(raw)  # type: ignore[arg-type]
+        except (TypeError, ValueError) as e:
+            raise MapFileError(f"{path}: invalid config ({e})") from None
+        if config is not None and stored != config:
+            raise MapFileError(f"{path}: was learned with {stored}, expected {config}")
+        try:
+            colors = ColorClasses.from_arrays(arrays)
+        except ValueError as e:
+            raise MapFileError(f"{path}: invalid colour classes ({e})") from None
+        vc = cls(stored, colors)
+        expect = {
+            "counts": vc._counts.shape,
+            "sector_observations": vc._n_obs.shape,
+            "frames_learned": (),
+        }
+        for key, shape in expect.items():
+            if key not in arrays:
+                raise MapFileError(f"{path}: missing entry {key!r}")
+            a = arrays[key]
+            if a.shape != shape or a.dtype.kind not in "iu":
+                raise MapFileError(
+                    f"{path}: entry {key!r} has shape {a.shape} and dtype {a.dtype}, "
+                    f"expected integer counts of shape {shape} for {stored}"
+                )
+        counts = arrays["counts"].astype(np.float64)
+        n_obs = arrays["sector_observations"].astype(np.float64)
+        # every class pair of a sector gets exactly one count per frame that saw it
+        per_pair = counts.sum(axis=2)
+        if not np.array_equal(per_pair, np.broadcast_to(n_obs[:, None], per_pair.shape)):
+            raise MapFileError(f"{path}: counts do not add up to the sector observations")
+        frames = int(arrays["frames_learned"])
+        if frames < 0 or (frames == 0) != (n_obs.sum() == 0):
+            raise MapFileError(f"{path}: frames_learned={frames} contradicts the counts")
+        ref = arrays.get("exposure_reference")
+        if ref is None or ref.shape != () or not np.isfinite(ref) or ref < 0:
+            raise MapFileError(f"{path}: entry 'exposure_reference' missing or invalid")
+        if stored.exposure == "mean" and ref <= 0:
+            raise MapFileError(f"{path}: exposure='mean' but no reference level stored")
+        vc._exposure_ref = float(ref)
+        sizes = arrays.get("learned_sizes")
+        if sizes is None or sizes.ndim != 2 or sizes.shape[1] != 2 or sizes.dtype.kind not in "iu":
+            raise MapFileError(f"{path}: entry 'learned_sizes' missing or not an (N, 2) int array")
+        vc._counts[:] = counts
+        vc._n_obs[:] = n_obs
+        vc._frames = frames
+        vc._sizes = {(int(a), int(b)) for a, b in sizes}
+        return vc
+
+    def __repr__(self) -> str:
+        return (
+            f"VisualCompass(frames_learned={self._frames}, "
+            f"learned={self.learned_fraction:.0%} of 360°, config={self.config})"
+        )

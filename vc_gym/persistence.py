@@ -1,0 +1,120 @@
+"""Atomic, pickle-free ``.npz`` files with a schema version.
+
+Every file holds a ``schema`` string, an integer ``schema_version`` and numeric or
+unicode arrays only. Loading never unpickles (``allow_pickle=False``); a file that is
+missing, truncated, of another schema or version raises :class:`MapFileError`
+naming the file and the reason.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import zipfile
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from vc_gym.errors import MapFileError
+
+__all__ = ["save_npz_atomic", "load_npz_checked", "json_array", "read_json_array"]
+
+
+def json_array(obj: object) -> np.ndarray:
+    """Encode a JSON-serialisable object as a 0-d unicode array (no pickling needed)."""
+    return np.array(json.dumps(obj, sort_keys=True))
+
+
+def read_json_array(arrays: Mapping[str, np.ndarray], key: str, path: str | os.PathLike) -> object:
+    """Decode an array written by :func:`json_array`, with a clear error on failure."""
+    if key not in arrays:
+        raise MapFileError(f"{path}: missing entry {key!r}")
+    a = arrays[key]
+    if a.dtype.kind != "U" or a.ndim != 0:
+        raise MapFileError(f"{path}: entry {key!r} is not a JSON string")
+    try:
+        return json.loads(str(a))
+    except json.JSONDecodeError as e:
+        raise MapFileError(f"{path}: entry {key!r} is not valid JSON ({e})") from None
+
+
+def save_npz_atomic(
+    path: str | os.PathLike, schema: str, version: int, arrays: Mapping[str, np.ndarray]
+) -> Path:
+    """Write ``arrays`` to ``path`` atomically (temporary file in the same folder + rename).
+
+    A crash while writing leaves any previous file at ``path`` untouched.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written (``.npz`` is appended if missing, like ``numpy.savez``).
+    """
+    path = Path(path)
+    if path.suffix != ".npz":
+        path = path.with_name(path.name + ".npz")
+    reserved = {"schema", "schema_version"} & set(arrays)
+    if reserved:
+        raise ValueError(f"array names {sorted(reserved)} are reserved")
+    for k, a in arrays.items():
+        a = np.asarray(a)
+        if a.dtype.kind not in "biufU":
+            raise ValueError(f"array {k!r} has dtype {a.dtype}; only numeric/unicode are saved")
+    folder = path.parent if str(path.parent) else Path(".")
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez_compressed(
+                fh,
+                schema=np.array(schema),
+                schema_version=np.array(version, dtype=np.int64),
+                **{k: np.asarray(v) for k, v in arrays.items()},
+            )
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
+
+
+def load_npz_checked(path: str | os.PathLike, schema: str, version: int) -> dict[str, np.ndarray]:
+    """Load every array of an ``.npz`` written by :func:`save_npz_atomic`.
+
+    Raises
+    ------
+    MapFileError
+        If the file is missing, empty, truncated or corrupt, has no or another
+        schema, or another schema version.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise MapFileError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise MapFileError(f"{path}: file is empty")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as e:
+        raise MapFileError(f"{path}: not a readable .npz file ({type(e).__name__}: {e})") from None
+    if "schema" not in arrays or "schema_version" not in arrays:
+        raise MapFileError(f"{path}: not a vc_gym file (no schema / schema_version entry)")
+    got_schema = str(arrays.pop("schema"))
+    if got_schema != schema:
+        raise MapFileError(f"{path}: holds a {got_schema!r}, expected a {schema!r}")
+    try:
+        got_version = int(arrays.pop("schema_version"))
+    except (TypeError, ValueError):
+        raise MapFileError(f"{path}: schema_version is not an integer") from None
+    if got_version != version:
+        raise MapFileError(
+            f"{path}: schema version {got_version}, this vc_gym reads version {version}"
+        )
+    return arrays
