@@ -418,3 +418,11 @@ def test_render_view_rejects_wrong_types() -> None:
         render_view(_pano(0).image, Camera())  # type: ignore[arg-type]
     with pytest.raises(TypeError):
         render_view(_pano(0), 0.0)  # type: ignore[arg-type]
+
+
+def test_render_view_returns_a_fresh_array_each_call():
+    pano = make_panorama(np.random.default_rng(0), width=720, height=180)
+    a = render_view(pano, Camera(yaw_deg=10.0))
+    b = render_view(pano, Camera(yaw_deg=10.0))
+    assert a is not b and not np.shares_memory(a, b)
+    np.testing.assert_array_equal(a, b)

@@ -226,7 +226,6 @@ def _ray_grid(
     return az_offset, elevation
 
 
-@functools.lru_cache(maxsize=64)
 def render_view(
     pano: Panorama,
     camera: Camera,

@@ -419,7 +419,12 @@ class VisualCompass:
             ``config.temperature``. All zeros if nothing above the horizon is visible.
         """
         self._checked(image, camera, need_map=True)
-        geom, counts, total = self._sector_features(image, camera)
+        return self._log_likelihood_of(*self._sector_features(image, camera))
+
+    def _log_likelihood_of(
+        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
+    ) -> np.ndarray:
+        """Log-likelihood over headings from sector features (see log_likelihood)."""
         delta_t, base, _ = self._log_tables()
         s_total = self.config.n_sectors
         n = self.config.n_bins
@@ -447,8 +452,9 @@ class VisualCompass:
 
         See :class:`CompassEstimate` for the meaning of each number (eq. 25-28).
         """
-        ll = self.log_likelihood(image, camera)
+        self._checked(image, camera, need_map=True)
         geom, counts, total = self._sector_features(image, camera)
+        ll = self._log_likelihood_of(geom, counts, total)
         n_h = ll.size
         best = int(np.argmax(ll))
         step = self.config.heading_step_deg

@@ -1,0 +1,107 @@
+"""Several spots (eq. 28-30) in a synthetic room with real parallax."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, NotLearnedError, VisualCompass
+from vc_gym.compass.synthetic_room import make_room, render_room_view
+
+SPOTS = {"east": (1.0, 0.0), "north": (0.0, 1.0), "west": (-1.0, 0.0), "south": (0.0, -1.0)}
+LEARN_YAWS = [b + p for b in range(0, 360, 45) for p in (-22.5, 0.0, 22.5)]
+TEST_YAWS = (10.0, 100.0, 200.0, 290.0)
+
+
+@pytest.fixture(scope="module")
+def room():
+    return make_room(np.random.default_rng(3))
+
+
+@pytest.fixture(scope="module")
+def atlas(room):
+    colors = None
+    spots = {}
+    for name, (x, y) in SPOTS.items():
+        vc = VisualCompass(CompassConfig(), colors)
+        if colors is None:
+            vc.fit_colors(
+                [render_room_view(room, 0.0, 0.0, Camera(yaw_deg=a)) for a in range(0, 360, 45)]
+            )
+            colors = vc.colors
+        for a in LEARN_YAWS:
+            vc.learn(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+        spots[name] = ((x, y), vc)
+    atlas = CompassAtlas(spots, home="centre")
+    home = [render_room_view(room, 0.0, 0.0, Camera(yaw_deg=a)) for a in range(0, 360, 10)]
+    atlas.normalize(home, [Camera()] * len(home))
+    return atlas
+
+
+def mean_position(atlas, room, x, y):
+    pos = [
+        atlas.estimate_position(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera()).position
+        for a in TEST_YAWS
+    ]
+    return np.mean(pos, axis=0)
+
+
+def test_home_is_estimated_at_home(atlas, room):
+    assert atlas.home_position == (0.0, 0.0)
+    assert np.hypot(*mean_position(atlas, room, 0.0, 0.0)) < 0.15
+
+
+@pytest.mark.parametrize("true", [(1.0, 0.0), (0.0, -1.0), (0.5, 0.0), (-0.5, 0.0)])
+def test_position_moves_towards_the_true_offset(atlas, room, true):
+    est = mean_position(atlas, room, *true)
+    bearing_err = math.degrees(
+        abs(math.remainder(math.atan2(est[1], est[0]) - math.atan2(true[1], true[0]), math.tau))
+    )
+    assert bearing_err < 30.0, est
+    assert np.hypot(*est) > 0.25 * np.hypot(*true), est
+
+
+def test_goodness_is_one_at_home_after_normalisation(atlas, room):
+    est = atlas.estimate_position(render_room_view(room, 0.0, 0.0, Camera(yaw_deg=40.0)), Camera())
+    assert set(est.goodness) == set(SPOTS)
+    for g in est.goodness.values():
+        assert g == pytest.approx(1.0, abs=0.1)
+    assert sum(est.weights.values()) == pytest.approx(1.0)
+    for e in est.estimates.values():
+        assert abs(math.remainder(e.heading_deg - 40.0, 360.0)) < 20.0  # 1 m of parallax
+
+
+def test_equal_goodness_gives_the_centroid(room):
+    vc = VisualCompass(CompassConfig(n_colors=3))
+    vc.fit_colors([render_room_view(room, 0.0, 0.0, Camera())])
+    vc.learn(render_room_view(room, 0.0, 0.0, Camera()), Camera())
+    atlas = CompassAtlas({"a": ((0.0, 0.0), vc), "b": ((2.0, 4.0), vc)}, home="a")
+    est = atlas.estimate_position(render_room_view(room, 0.5, 0.5, Camera()), Camera())
+    assert est.position == pytest.approx((1.0, 2.0))
+    assert atlas.home_position == (0.0, 0.0)
+
+
+def test_bad_atlas_arguments(room):
+    vc = VisualCompass()
+    with pytest.raises(ValueError):
+        CompassAtlas({}, home="x")
+    with pytest.raises(ValueError):
+        CompassAtlas({"a": (0.0, vc)}, home="a")
+    with pytest.raises(ValueError):
+        CompassAtlas({"a": ((0.0, float("nan")), vc)}, home="a")
+    with pytest.raises(ValueError):
+        CompassAtlas({"a": ((0.0, 0.0), "not a compass")}, home="a")
+    with pytest.raises(ValueError, match="CompassConfig"):
+        CompassAtlas(
+            {"a": ((0, 0), vc), "b": ((1, 0), VisualCompass(CompassConfig(n_colors=3)))}, home="a"
+        )
+    with pytest.raises(ValueError):
+        CompassAtlas({"a": ((0.0, 0.0), vc)}, home="a", sharpness=0.0)
+    atlas = CompassAtlas({"a": ((0.0, 0.0), vc)}, home="a")
+    img = render_room_view(room, 0.0, 0.0, Camera())
+    with pytest.raises(NotLearnedError):
+        atlas.estimate_position(img, Camera())
+    with pytest.raises(ValueError):
+        atlas.normalize([img, img], [Camera()])

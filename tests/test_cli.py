@@ -1,0 +1,62 @@
+"""The ``vc-gym`` command end to end (small budgets)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from vc_gym.cli import main
+
+
+def test_help_lists_subcommands(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--help"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    for cmd in ("demo", "bench", "experiment"):
+        assert cmd in out
+
+
+def test_console_script_is_installed():
+    r = subprocess.run(
+        [sys.executable, "-m", "vc_gym.cli", "--version"], capture_output=True, text=True
+    )
+    assert r.returncode == 0 and "vc_gym" in r.stdout
+
+
+def test_demo_writes_summary_and_plot(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path), "--frames", "6", "--seed", "3"]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert set(summary["results"]) == {
+        "room/exposure=none",
+        "room/exposure=mean",
+        "outdoor/exposure=none",
+        "outdoor/exposure=mean",
+    }
+    normal = summary["results"]["room/exposure=none"]["illumination_1.0"]
+    assert normal["median_error_deg"] < 5.0
+    png = (tmp_path / "demo.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def test_bench_compass_json_last_line(capsys):
+    assert main(["bench", "compass", "--json", "--frames", "2", "--repeats", "1"]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    result = json.loads(last)
+    for key in ("learn_ms", "localize_ms", "floor_ms", "pixels_per_s"):
+        assert result[key] > 0
+    assert result["scanned_pixels"] == 104 * 40
+    assert result["median_heading_error_deg"] < 5.0
+
+
+def test_experiment_without_data_fails_clearly(tmp_path, capsys):
+    assert main(["experiment", "real-rotation", "--data", str(tmp_path / "nope")]) == 2
+    assert "not found" in capsys.readouterr().err
+
+
+def test_bad_arguments_exit_nonzero(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path), "--frames", "0"]) == 2
+    assert "n_test" in capsys.readouterr().err

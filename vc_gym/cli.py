@@ -1,0 +1,166 @@
+"""The ``vc-gym`` command."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+__all__ = ["main"]
+
+
+def _write_json(path: str | os.PathLike, obj: object) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name("." + path.name + ".tmp")
+    tmp.write_text(json.dumps(obj, indent=2))
+    os.replace(tmp, path)
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from vc_gym.experiments.demo import run_demo
+
+    summary = run_demo(args.out, seed=args.seed, n_test=args.frames)
+    for label, entry in summary["results"].items():
+        parts = [
+            f"light×{k.split('_')[1]}: median {v['median_error_deg']:.2f}°, "
+            f"{v['within_5deg']:.0%} within 5°"
+            for k, v in entry.items()
+        ]
+        print(f"{label:28s} " + " | ".join(parts))
+    print(f"wrote {Path(args.out) / 'summary.json'} and {Path(args.out) / 'demo.png'}")
+    return 0
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    if args.what == "compass":
+        from vc_gym.experiments.bench_compass import bench_compass
+
+        result = bench_compass(
+            frames=args.frames, repeats=args.repeats, seed=args.seed, progress=not args.json
+        )
+        if not args.json:
+            print(
+                f"learn {result['learn_ms']:.3f} ms, localize {result['localize_ms']:.3f} ms, "
+                f"floor {result['floor_ms']:.4f} ms per {result['frame']} frame "
+                f"({result['pixels_per_s'] / 1e6:.1f} Mpixel/s); "
+                f"paper (Aibo): learn {result['paper_aibo_learn_ms']} ms, "
+                f"localize {result['paper_aibo_localize_ms']} ms"
+            )
+    else:  # pragma: no cover - argparse restricts the choices
+        raise AssertionError(args.what)
+    if args.out:
+        _write_json(args.out, result)
+    if args.json:
+        print(json.dumps(result))
+    return 0
+
+
+def _cmd_experiment(args: argparse.Namespace) -> int:
+    if args.name == "real-rotation":
+        from vc_gym.experiments.real_data import default_real_data_dir
+        from vc_gym.experiments.real_rotation import run_real_rotation
+
+        data = Path(args.data) if args.data else default_real_data_dir()
+        if data is None or not data.is_dir():
+            print(
+                "real photos not found: pass --data DIR (the folder holding rotation_grail/ "
+                "and rotation_parrington/) or set VC_GYM_REAL_DATA",
+                file=sys.stderr,
+            )
+            return 2
+        result = run_real_rotation(data, progress=not args.json)
+        if not args.json:
+            print(f"{'set':22s} {'classes':>7s} {'exposure':>8s} {'median':>8s} {'<5°':>5s}")
+            for r in result["results"]:
+                print(
+                    f"{r['set']:22s} {r['n_colors']:7d} {r['exposure']:>8s} "
+                    f"{r['median_error_deg']:7.2f}° {r['within_5deg']:5.0%}"
+                )
+    else:  # pragma: no cover
+        raise AssertionError(args.name)
+    if args.out:
+        _write_json(args.out, result)
+    if args.json:
+        print(json.dumps(result))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``vc-gym`` (exposed for documentation and tests)."""
+    from vc_gym import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="vc-gym",
+        description=(
+            "vc_gym: the appearance-based visual compass of Sturm & Visser - compass "
+            "sensor, filters, simulated quadruped room and homing agents."
+        ),
+    )
+    parser.add_argument("--version", action="version", version=f"vc_gym {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    p = sub.add_parser(
+        "demo",
+        help="the main job: learn a place, then tell headings (writes summary.json, demo.png)",
+        description=(
+            "Learn synthetic room and outdoor panoramas the way the paper's robot does "
+            "(8 x 45 deg with head scanning), estimate the heading of random test frames at "
+            "normal and half illumination, and write DIR/summary.json and DIR/demo.png."
+        ),
+    )
+    p.add_argument("--out", default="vc_gym_demo", metavar="DIR", help="output folder")
+    p.add_argument("--seed", type=int, default=0, help="seed of scenes and test headings")
+    p.add_argument("--frames", type=int, default=120, help="test frames per scene")
+    p.set_defaults(func=_cmd_demo)
+
+    p = sub.add_parser(
+        "bench",
+        help="speed benchmarks (medians measured side by side in one run)",
+        description=(
+            "compass: learning and localisation time per 208x160 frame at the paper's "
+            "defaults, next to the floor (copying the scanned pixels once). The last line "
+            "of --json output is one JSON object."
+        ),
+    )
+    p.add_argument("what", choices=["compass"], help="what to benchmark")
+    p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
+    p.add_argument("--frames", type=int, default=40, help="distinct test frames")
+    p.add_argument("--repeats", type=int, default=15, help="timed rounds over all frames")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=_cmd_bench)
+
+    p = sub.add_parser(
+        "experiment",
+        help="the paper's experiments and evaluations on real data",
+        description=(
+            "real-rotation: learn from 9 alternate photos of a camera turning in place and "
+            "estimate the yaw of crops of the other 9, for the indoor and outdoor sets, with "
+            "10 and 3 colour classes, without and with exposure normalisation."
+        ),
+    )
+    p.add_argument("name", choices=["real-rotation"], help="which experiment")
+    p.add_argument("--data", metavar="DIR", help="folder of the real photo sets")
+    p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
+    p.set_defaults(func=_cmd_experiment)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``vc-gym``; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ValueError, FileNotFoundError) as e:
+        print(f"vc-gym {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
