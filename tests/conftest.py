@@ -33,6 +33,12 @@ def learned_compass(pano: Panorama, config: CompassConfig | None = None) -> Visu
 
 
 @pytest.fixture(scope="session")
+def make_learned_compass():
+    """The :func:`learned_compass` factory, for tests that need their own config."""
+    return learned_compass
+
+
+@pytest.fixture(scope="session")
 def room_compass(room_pano: Panorama) -> VisualCompass:
     return learned_compass(room_pano)
 

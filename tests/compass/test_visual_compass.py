@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.conftest import learned_compass
 from vc_gym.compass import (
     Camera,
     CompassConfig,
@@ -32,22 +31,22 @@ def test_recovers_random_yaws_in_a_room(room_pano, room_compass):
     assert np.mean(errs < 5.0) >= 0.95, np.sort(errs)[-5:]
 
 
-def test_recovers_random_yaws_outdoors(outdoor_pano):
-    vc = learned_compass(outdoor_pano)
+def test_recovers_random_yaws_outdoors(outdoor_pano, make_learned_compass):
+    vc = make_learned_compass(outdoor_pano)
     yaws = np.random.default_rng(12).uniform(0.0, 360.0, 40)
     errs = heading_errors(vc, outdoor_pano, yaws)
     assert np.mean(errs < 5.0) >= 0.95, np.sort(errs)[-5:]
 
 
-def test_three_colour_classes_suffice(room_pano):
-    vc = learned_compass(room_pano, CompassConfig(n_colors=3))
+def test_three_colour_classes_suffice(room_pano, make_learned_compass):
+    vc = make_learned_compass(room_pano, CompassConfig(n_colors=3))
     yaws = np.random.default_rng(13).uniform(0.0, 360.0, 30)
     assert np.mean(heading_errors(vc, room_pano, yaws) < 5.0) >= 0.9
 
 
-def test_sparse_scanning_grid_still_works(room_pano):
+def test_sparse_scanning_grid_still_works(room_pano, make_learned_compass):
     # paper 5.3: coverage can go below 1 % without much loss
-    vc = learned_compass(room_pano, CompassConfig(coverage=0.01))
+    vc = make_learned_compass(room_pano, CompassConfig(coverage=0.01))
     assert vc.config.grid_steps == (10, 10)
     yaws = np.random.default_rng(14).uniform(0.0, 360.0, 30)
     assert np.median(heading_errors(vc, room_pano, yaws)) < 5.0
@@ -79,9 +78,9 @@ def test_pitch_is_handled(room_pano, room_compass):
 
 
 @pytest.mark.parametrize("illumination", [0.5, 0.25, 1.5])
-def test_exposure_mean_undoes_illumination_changes(room_pano, illumination):
+def test_exposure_mean_undoes_illumination_changes(room_pano, illumination, make_learned_compass):
     # paper 5.3 tests half the illumination of learning; exposure="mean" undoes it
-    vc = learned_compass(room_pano, CompassConfig(exposure="mean"))
+    vc = make_learned_compass(room_pano, CompassConfig(exposure="mean"))
     yaws = np.random.default_rng(16).uniform(0.0, 360.0, 20)
     errs = []
     for yaw in yaws:
@@ -90,8 +89,8 @@ def test_exposure_mean_undoes_illumination_changes(room_pano, illumination):
     assert np.mean(np.array(errs) < 5.0) >= 0.95, np.round(errs, 1)
 
 
-def test_exposure_reference_survives_save_load(tmp_path, room_pano):
-    vc = learned_compass(room_pano, CompassConfig(exposure="mean", n_colors=4))
+def test_exposure_reference_survives_save_load(tmp_path, room_pano, make_learned_compass):
+    vc = make_learned_compass(room_pano, CompassConfig(exposure="mean", n_colors=4))
     loaded = VisualCompass.load(vc.save(tmp_path / "m.npz"))
     img = render_view(room_pano, Camera(yaw_deg=33.0), illumination=0.5)
     np.testing.assert_array_equal(
@@ -184,9 +183,9 @@ def test_not_learned_errors(room_pano):
         VisualCompass().save("never.npz")
 
 
-def test_refitting_colours_needs_reset(room_pano, room_compass):
+def test_refitting_colours_needs_reset(room_pano, room_compass, make_learned_compass):
     img = render_view(room_pano, Camera())
-    vc = learned_compass(room_pano, CompassConfig(n_colors=3))
+    vc = make_learned_compass(room_pano, CompassConfig(n_colors=3))
     with pytest.raises(ValueError, match="reset_map"):
         vc.fit_colors([img])
     vc.fit_colors([img], reset_map=True)
