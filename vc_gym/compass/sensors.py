@@ -1,0 +1,129 @@
+"""The compass and the atlas as sensor models for the filters (paper eq. 22).
+
+They satisfy the structural protocols of :mod:`vc_gym.filters.protocol` without
+importing the filters: a :class:`CompassHeadingSensor` is a heading sensor (and a
+heading-only pose sensor), an :class:`AtlasPoseSensor` a pose sensor. The observation
+of both is a camera image.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vc_gym.compass.atlas import CompassAtlas
+from vc_gym.compass.camera import Camera
+from vc_gym.compass.visual_compass import VisualCompass
+
+__all__ = ["CompassHeadingSensor", "AtlasPoseSensor", "interp_circular"]
+
+
+def interp_circular(values: np.ndarray, step_deg: float, query_deg: np.ndarray) -> np.ndarray:
+    """Linear interpolation of ``values`` sampled at ``0, step, 2 step, ...`` (circular).
+
+    Exact where the query falls on the grid; ``-inf`` neighbours give ``-inf``.
+    """
+    n = values.size
+    pos = np.mod(np.asarray(query_deg, dtype=np.float64), 360.0) / step_deg
+    i0 = np.floor(pos).astype(np.int64)
+    frac = pos - i0
+    a = values[i0 % n]
+    b = values[(i0 + 1) % n]
+    with np.errstate(invalid="ignore"):
+        out = np.where(frac == 0.0, a, (1.0 - frac) * a + frac * b)
+    return out
+
+
+class CompassHeadingSensor:
+    """A :class:`VisualCompass` seen by a filter: images in, heading log-likelihoods out.
+
+    Parameters
+    ----------
+    compass : VisualCompass
+        A compass with a learned map.
+    camera : Camera
+        Intrinsics and pitch of the camera that takes the observations (its yaw is
+        ignored). With a turnable head, pass ``head_pan_deg`` to the call instead.
+    """
+
+    def __init__(self, compass: VisualCompass, camera: Camera | None = None):
+        if not isinstance(compass, VisualCompass):
+            raise ValueError(f"compass must be a VisualCompass, got {type(compass).__name__}")
+        self.compass = compass
+        self.camera = Camera() if camera is None else camera
+        if not isinstance(self.camera, Camera):
+            raise ValueError(f"camera must be a Camera, got {type(self.camera).__name__}")
+
+    def heading_log_likelihood(
+        self, observation: np.ndarray, headings_deg: np.ndarray, head_pan_deg: float = 0.0
+    ) -> np.ndarray:
+        """Log-likelihood of every body heading for one camera image.
+
+        The compass answers for the camera's heading; with the head panned by
+        ``head_pan_deg`` (left positive) the body heading is the camera heading minus
+        the pan. Headings between the compass grid points are interpolated.
+        """
+        if not math.isfinite(head_pan_deg):
+            raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
+        ll = self.compass.log_likelihood(observation, self.camera)
+        return interp_circular(
+            ll, self.compass.config.heading_step_deg, np.asarray(headings_deg) + head_pan_deg
+        )
+
+    def pose_log_likelihood(self, observation: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Heading-only pose likelihood: depends on the ``θ`` column of ``poses`` alone."""
+        return self.heading_log_likelihood(observation, np.asarray(poses)[:, 2])
+
+
+class AtlasPoseSensor:
+    """A :class:`CompassAtlas` as a pose sensor: position from eq. 30, heading from eq. 16.
+
+    The log-likelihood of a pose ``(x, y, θ)`` is
+    ``-|(x, y) - τ̂|² / (2 σ²)`` for the atlas position ``τ̂`` plus the best-fitting
+    spot's heading log-likelihood at ``θ``, divided by ``heading_temperature``.
+
+    Parameters
+    ----------
+    atlas : CompassAtlas
+        Learned and normalised atlas.
+    camera : Camera
+        The camera that takes the observations.
+    position_noise_m : float
+        σ of the position reading (the atlas position is coarse: ~0.3 m, paper 5.2).
+    heading_temperature : float
+        Divides the heading log-likelihood; the raw product of eq. 16 is very peaked.
+    """
+
+    def __init__(
+        self,
+        atlas: CompassAtlas,
+        camera: Camera | None = None,
+        position_noise_m: float = 0.3,
+        heading_temperature: float = 1.0,
+    ):
+        if not isinstance(atlas, CompassAtlas):
+            raise ValueError(f"atlas must be a CompassAtlas, got {type(atlas).__name__}")
+        for name, v in (
+            ("position_noise_m", position_noise_m),
+            ("heading_temperature", heading_temperature),
+        ):
+            if not math.isfinite(v) or v <= 0:
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        self.atlas = atlas
+        self.camera = Camera() if camera is None else camera
+        self.position_noise_m = float(position_noise_m)
+        self.heading_temperature = float(heading_temperature)
+
+    def pose_log_likelihood(self, observation: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Log-likelihood of every row ``(x, y, θ)`` of ``poses`` for one image."""
+        p = np.asarray(poses, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
+        est = self.atlas.estimate_position(observation, self.camera)
+        best = max(est.goodness, key=est.goodness.get)
+        ll_heading = est.estimates[best].log_likelihood
+        step = self.atlas.compasses[0].config.heading_step_deg
+        d2 = (p[:, 0] - est.position[0]) ** 2 + (p[:, 1] - est.position[1]) ** 2
+        heading = interp_circular(ll_heading, step, p[:, 2]) / self.heading_temperature
+        return heading - 0.5 * d2 / self.position_noise_m**2
