@@ -15,22 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vc_gym.validation import finite_float as _finite
+
 __all__ = ["Camera", "AIBO_HFOV_DEG", "AIBO_RESOLUTION"]
 
 #: Horizontal field of view of the Sony Aibo ERS-7 camera (degrees).
 AIBO_HFOV_DEG = 56.9
 #: (width, height) of the Aibo ERS-7 camera image.
 AIBO_RESOLUTION = (208, 160)
-
-
-def _finite(name: str, value: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,7 @@ from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.exposure import gain_table
 from vc_gym.images import check_image
+from vc_gym.validation import finite_float as _finite
 
 __all__ = ["Panorama", "PANORAMA_KINDS", "make_panorama", "render_view", "equirectangular"]
 
@@ -70,16 +71,6 @@ _VERTICAL_PAD = {
 }
 # cv2.remap refuses sources with a side of SHRT_MAX (32767) pixels or more.
 _REMAP_MAX_SIDE = 32766
-
-
-def _finite(name: str, value: object) -> float:
-    try:
-        v = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
 
 
 def _int_at_least(name: str, value: object, minimum: int) -> int:

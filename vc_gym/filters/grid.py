@@ -18,21 +18,12 @@ import numpy as np
 from vc_gym.angles import circular_mean, circular_std
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
+from vc_gym.validation import finite_float as _finite
 
 __all__ = ["HeadingGridFilter", "mixing_lambda", "RULES"]
 
 #: Sensor update rules of :class:`HeadingGridFilter`.
 RULES = ("mixing", "bayes")
-
-
-def _finite(name: str, value: object) -> float:
-    try:
-        v = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
 
 
 def mixing_lambda(half_life_s: float, dt_s: float) -> float:

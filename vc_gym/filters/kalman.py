@@ -36,6 +36,7 @@ from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 from vc_gym.angles import circular_mean, circular_std, wrap180, wrap360
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
+from vc_gym.validation import finite_float as _finite
 
 __all__ = ["KalmanHeadingFilter"]
 
@@ -47,13 +48,6 @@ _BETA = 2.0
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _finite(name: str, value: Any) -> float:
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
 
 
 def _positive_finite(name: str, value: Any) -> float:
