@@ -51,7 +51,7 @@ import numpy as np
 
 from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass.camera import Camera
-from vc_gym.compass.exposure import gain_table
+from vc_gym.exposure import gain_table
 from vc_gym.images import check_image
 from vc_gym.validation import finite_float as _finite
 

@@ -54,8 +54,8 @@ import cv2
 import numpy as np
 
 from vc_gym.compass.camera import Camera
-from vc_gym.compass.exposure import gain_table
 from vc_gym.compass.synthetic import _REMAP_MAX_SIDE, _finite, _hsv, _int_at_least, _noise_2d
+from vc_gym.exposure import gain_table
 from vc_gym.images import check_image
 
 __all__ = ["Room", "make_room", "render_room_view"]

@@ -19,9 +19,9 @@ from vc_gym.angles import circular_std, wrap360
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
-from vc_gym.compass.exposure import gain_table, mean_linear_level
 from vc_gym.compass.features import ScanGrid, column_transition_counts, log2_bin, scan_grid
 from vc_gym.errors import MapFileError, NotLearnedError
+from vc_gym.exposure import gain_table, mean_linear_level
 from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 
