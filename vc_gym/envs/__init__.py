@@ -1,0 +1,1 @@
+"""PyBullet world, robot, camera, Gymnasium envs and wrappers."""
