@@ -63,6 +63,17 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                     f"{name:20s} mean error {v['mean_error_deg']:6.2f}°, "
                     f"max {v['max_error_deg']:6.1f}°"
                 )
+    elif args.what == "env":
+        from vc_gym.experiments.bench_env import bench_env
+
+        result = bench_env(rounds=max(1, args.repeats // 3), seed=args.seed)
+        if not args.json:
+            print(
+                f"env {result['steps_per_s']:.1f} steps/s, bare PyBullet "
+                f"{result['bare_steps_per_s']:.1f} steps/s (ratio {result['env_over_bare']:.2f}); "
+                f"2 async envs: x{result['async2_speedup']:.2f}, "
+                f"2 sync envs: x{result['sync2_speedup']:.2f}"
+            )
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:
@@ -102,6 +113,16 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_render(args: argparse.Namespace) -> int:
+    from vc_gym.envs.scenes import SCENES
+    from vc_gym.experiments.render_scenes import render_scene_pictures
+
+    scenes = tuple(SCENES) if args.scene == "all" else (args.scene,)
+    for path in render_scene_pictures(args.out, scenes, seed=args.seed, randomize=args.randomize):
+        print(f"wrote {path}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``vc-gym`` (exposed for documentation and tests)."""
     from vc_gym import __version__
@@ -137,11 +158,13 @@ def build_parser() -> argparse.ArgumentParser:
             "compass: learning and localisation time per 208x160 frame at the paper's "
             "defaults, next to the floor (copying the scanned pixels once). filters: cost of "
             "one update of every filter (1 deg grid, 1,000 and 10,000 particles, Kalman) and "
-            "their heading errors on one seeded tracking run with the real compass. The last "
-            "line of --json output is one JSON object."
+            "their heading errors on one seeded tracking run with the real compass. env: steps per "
+            "second of vc_gym/AiboRoom-v0 next to bare PyBullet doing the same physics and "
+            "render, and the speed-up of 2 async envs. The last line of --json output is one "
+            "JSON object."
         ),
     )
-    p.add_argument("what", choices=["compass", "filters"], help="what to benchmark")
+    p.add_argument("what", choices=["compass", "filters", "env"], help="what to benchmark")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
     p.add_argument("--frames", type=int, default=40, help="compass: distinct test frames")
@@ -149,6 +172,26 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PNG", help="filters: save a plot of the tracking run")
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=_cmd_bench)
+
+    p = sub.add_parser(
+        "render",
+        help="pictures of the simulated scenes (top view and a 360 deg strip of head views)",
+        description=(
+            "Write DIR/<scene>_top.png (top view with the robot, its heading and its camera's "
+            "field of view) and DIR/<scene>_strip.png (8 head-camera frames, 45 deg apart, "
+            "from the centre of the field) for one or every scene."
+        ),
+    )
+    p.add_argument(
+        "--scene",
+        default="all",
+        choices=["all", "robolab", "office", "home", "outdoor_field"],
+        help="which scene (default: all)",
+    )
+    p.add_argument("--out", default="vc_gym_scenes", metavar="DIR", help="output folder")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--randomize", action="store_true", help="domain-randomised scene")
+    p.set_defaults(func=_cmd_render)
 
     p = sub.add_parser(
         "experiment",

@@ -1,0 +1,71 @@
+"""Pictures of the scenes: a top view and a 360° strip of head-camera views."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.scenes import SCENES
+
+__all__ = ["render_scene_pictures"]
+
+
+def _write_png(path: Path, rgb: np.ndarray) -> None:
+    tmp = path.with_name("." + path.name + ".tmp.png")
+    if not cv2.imwrite(str(tmp), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+        raise OSError(f"could not write {path}")
+    os.replace(tmp, path)
+
+
+def render_scene_pictures(
+    out_dir: str | os.PathLike,
+    scenes: tuple[str, ...] = SCENES,
+    seed: int = 0,
+    randomize: bool = False,
+    n_views: int = 8,
+) -> list[Path]:
+    """Write ``{scene}_top.png`` and ``{scene}_strip.png`` for each scene.
+
+    The robot stands at the centre of the field; the strip holds ``n_views`` head
+    frames at headings ``0, 360/n, ...`` degrees, left to right, labelled.
+    """
+    if n_views < 1:
+        raise ValueError(f"n_views must be >= 1, got {n_views}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for scene in scenes:
+        env = AiboRoomEnv(render_mode="rgb_array", scene=scene, randomize=randomize)
+        try:
+            env.reset(seed=seed)
+            fx0, fx1, fy0, fy1 = env.scene.field_bounds
+            cx, cy = (fx0 + fx1) / 2.0, (fy0 + fy1) / 2.0
+            views = []
+            for k in range(n_views):
+                yaw = 360.0 * k / n_views
+                obs, _ = env.reset(seed=seed, options={"pose": (cx, cy, yaw)})
+                img = obs["image"].copy()
+                cv2.putText(
+                    img,
+                    f"{yaw:.0f} deg",
+                    (4, 14),
+                    cv2.FONT_HERSHEY_SIMPLEX,
+                    0.45,
+                    (255, 255, 255),
+                    1,
+                    cv2.LINE_AA,
+                )
+                views.append(img)
+            env.reset(seed=seed, options={"pose": (cx, cy, 30.0)})
+            frame = env.render()
+            top = frame[:, : frame.shape[0]]
+            for name, rgb in ((f"{scene}_top.png", top), (f"{scene}_strip.png", np.hstack(views))):
+                _write_png(out / name, rgb)
+                written.append(out / name)
+        finally:
+            env.close()
+    return written
