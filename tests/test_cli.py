@@ -27,9 +27,9 @@ def test_console_script_is_installed():
     assert r.returncode == 0 and "vc_gym" in r.stdout
 
 
-def test_demo_writes_summary_and_plot(tmp_path, capsys):
-    assert main(["demo", "--out", str(tmp_path), "--frames", "6", "--seed", "3"]) == 0
-    summary = json.loads((tmp_path / "summary.json").read_text())
+def test_synthetic_compass_writes_summary_and_plot(tmp_path, capsys):
+    assert main(["experiment", "synthetic-compass", "--out-dir", str(tmp_path), "--seed", "3"]) == 0
+    summary = json.loads((tmp_path / "synthetic_compass.json").read_text())
     assert set(summary["results"]) == {
         "room/exposure=none",
         "room/exposure=mean",
@@ -38,7 +38,7 @@ def test_demo_writes_summary_and_plot(tmp_path, capsys):
     }
     normal = summary["results"]["room/exposure=none"]["illumination_1.0"]
     assert normal["median_error_deg"] < 5.0
-    png = (tmp_path / "demo.png").read_bytes()
+    png = (tmp_path / "synthetic_compass.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
 
 
@@ -57,6 +57,10 @@ def test_experiment_without_data_fails_clearly(tmp_path, capsys):
     assert "not found" in capsys.readouterr().err
 
 
-def test_bad_arguments_exit_nonzero(tmp_path, capsys):
-    assert main(["demo", "--out", str(tmp_path), "--frames", "0"]) == 2
-    assert "n_test" in capsys.readouterr().err
+def test_demo_runs_the_main_job(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path), "--learn-time", "0.3", "--seed", "1"]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    for key in ("home_error_m", "final_heading_error_deg", "success", "duration_s"):
+        assert key in summary
+    assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
+    assert "cm from home" in capsys.readouterr().out

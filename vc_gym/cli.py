@@ -23,14 +23,14 @@ def _write_json(path: str | os.PathLike, obj: object) -> None:
 def _cmd_demo(args: argparse.Namespace) -> int:
     from vc_gym.experiments.demo import run_demo
 
-    summary = run_demo(args.out, seed=args.seed, n_test=args.frames)
-    for label, entry in summary["results"].items():
-        parts = [
-            f"light×{k.split('_')[1]}: median {v['median_error_deg']:.2f}°, "
-            f"{v['within_5deg']:.0%} within 5°"
-            for k, v in entry.items()
-        ]
-        print(f"{label:28s} " + " | ".join(parts))
+    s = run_demo(args.out, seed=args.seed, learn_time_s=args.learn_time)
+    dx, dy = (100 * v for v in s["stop_offset_m"])
+    print(
+        f"stopped {s['home_error_m'] * 100:.1f} cm from home "
+        f"(offset x {dx:+.1f} cm, y {dy:+.1f} cm), "
+        f"final heading error {s['final_heading_error_deg']:.1f} deg, "
+        f"success: {s['success']}, {s['duration_s']:.0f} s"
+    )
     print(f"wrote {Path(args.out) / 'summary.json'} and {Path(args.out) / 'demo.png'}")
     return 0
 
@@ -84,7 +84,21 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
-    if args.name == "real-rotation":
+    if args.name == "synthetic-compass":
+        from vc_gym.experiments.synthetic_compass import run_synthetic_compass
+
+        out_dir = args.out_dir or "vc_gym_synthetic"
+        result = run_synthetic_compass(out_dir, seed=args.seed)
+        if not args.json:
+            for label, entry in result["results"].items():
+                parts = [
+                    f"light×{k.split('_')[1]}: median {v['median_error_deg']:.2f}°, "
+                    f"{v['within_5deg']:.0%} within 5°"
+                    for k, v in entry.items()
+                ]
+                print(f"{label:28s} " + " | ".join(parts))
+            print(f"wrote {Path(out_dir) / 'synthetic_compass.png'}")
+    elif args.name == "real-rotation":
         from vc_gym.experiments.real_data import default_real_data_dir
         from vc_gym.experiments.real_rotation import run_real_rotation
 
@@ -139,16 +153,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "demo",
-        help="the main job: learn a place, then tell headings (writes summary.json, demo.png)",
+        help="the main job: learn a place, get kidnapped, walk home (summary.json, demo.png)",
         description=(
-            "Learn synthetic room and outdoor panoramas the way the paper's robot does "
-            "(8 x 45 deg with head scanning), estimate the heading of random test frames at "
-            "normal and half illumination, and write DIR/summary.json and DIR/demo.png."
+            "One learn-then-home episode in the simulated robot lab with the scripted agents "
+            "(paper 4.3, 5.2): learn the panorama at 4 spots 1 m around home (8 x 45 deg, "
+            "head scanning), normalise at home, get kidnapped to a random pose, walk home "
+            "with the orientational and translational filters. Writes DIR/summary.json "
+            "(home error, heading error, success, duration) and DIR/demo.png."
         ),
     )
     p.add_argument("--out", default="vc_gym_demo", metavar="DIR", help="output folder")
-    p.add_argument("--seed", type=int, default=0, help="seed of scenes and test headings")
-    p.add_argument("--frames", type=int, default=120, help="test frames per scene")
+    p.add_argument("--seed", type=int, default=0, help="seed of odometry errors and kidnapping")
+    p.add_argument(
+        "--learn-time", type=float, default=5.0, help="seconds per learning direction (paper: 5)"
+    )
     p.set_defaults(func=_cmd_demo)
 
     p = sub.add_parser(
@@ -199,11 +217,17 @@ def build_parser() -> argparse.ArgumentParser:
         description=(
             "real-rotation: learn from 9 alternate photos of a camera turning in place and "
             "estimate the yaw of crops of the other 9, for the indoor and outdoor sets, with "
-            "10 and 3 colour classes, without and with exposure normalisation."
+            "10 and 3 colour classes, without and with exposure normalisation. "
+            "synthetic-compass: learn synthetic room and outdoor panoramas (8 x 45 deg with "
+            "head pans) and estimate random headings at normal and half illumination."
         ),
     )
-    p.add_argument("name", choices=["real-rotation"], help="which experiment")
-    p.add_argument("--data", metavar="DIR", help="folder of the real photo sets")
+    p.add_argument("name", choices=["real-rotation", "synthetic-compass"], help="which experiment")
+    p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
+    p.add_argument(
+        "--out-dir", metavar="DIR", help="synthetic-compass: folder for the JSON and the plot"
+    )
+    p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
     p.set_defaults(func=_cmd_experiment)

@@ -1,9 +1,8 @@
-"""The package's main job (until the simulator lands): the compass on synthetic scenes.
+"""The package's main job: one learn-then-home episode in the simulated robot lab.
 
-Learns a room panorama the way the paper's robot does (8 body directions of 45°, each
-with head scanning, paper 4.3), then estimates the heading of random test frames at
-normal and at half illumination (paper 5.3), and writes ``summary.json`` and
-``demo.png``.
+The scripted robot learns the panorama at four spots 1 m around home, is kidnapped to
+a random pose on the field and walks back home with its orientational and translational
+filters (paper 4.3, 5.2). Writes ``summary.json`` and ``demo.png``.
 """
 
 from __future__ import annotations
@@ -13,149 +12,124 @@ import os
 import time
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
-from tqdm import tqdm
 
-from vc_gym.angles import wrap180
-from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
-from vc_gym.compass.synthetic import Panorama, make_panorama, render_view
+import vc_gym  # noqa: F401  (registers the envs)
+from vc_gym.agents.scripted import EpisodeRecord, LearnThenHomeConfig, ScriptedLearnThenHome
+from vc_gym.envs.top_view import TopView
 
 __all__ = ["run_demo"]
 
-HEAD_PANS_DEG = (-22.5, 0.0, 22.5)
-BODY_YAWS_DEG = tuple(range(0, 360, 45))
 
+def run_demo(
+    out_dir: str | os.PathLike = "vc_gym_demo",
+    seed: int = 0,
+    learn_time_s: float = 5.0,
+    success_radius_m: float = 0.3,
+    progress: bool = True,
+) -> dict[str, object]:
+    """Run one scripted learn-then-home episode in the robolab and save the results.
 
-def _learn(vc: VisualCompass, pano: Panorama, label: str) -> None:
-    w, h = AIBO_RESOLUTION
-    views = [(b + p) for b in BODY_YAWS_DEG for p in HEAD_PANS_DEG]
-    for yaw in tqdm(views, desc=f"learn {label}", unit="frame", leave=False):
-        vc.learn(render_view(pano, Camera(yaw_deg=yaw), w, h), Camera(yaw_deg=yaw))
+    Parameters
+    ----------
+    out_dir : path-like
+        Where ``summary.json`` and ``demo.png`` go.
+    seed : int
+        Seed of the env (odometry errors) and of the kidnapping pose.
+    learn_time_s : float
+        Learning time per direction (paper: 5 s).
+    success_radius_m : float
+        The episode succeeds if the robot stops within this distance of home.
+    progress : bool
+        Progress bars per phase.
 
-
-def _evaluate(
-    vc: VisualCompass, pano: Panorama, yaws: np.ndarray, illumination: float, label: str
-) -> np.ndarray:
-    w, h = AIBO_RESOLUTION
-    errs = []
-    for yaw in tqdm(yaws, desc=f"localise {label}", unit="frame", leave=False):
-        img = render_view(pano, Camera(yaw_deg=float(yaw)), w, h, illumination=illumination)
-        errs.append(float(wrap180(vc.estimate(img, Camera()).heading_deg - yaw)))
-    return np.array(errs)
-
-
-def run_demo(out_dir: str | os.PathLike = "vc_gym_demo", seed: int = 0, n_test: int = 120) -> dict:
-    """Run the compass demo and write ``summary.json`` and ``demo.png`` to ``out_dir``.
-
-    Returns the summary dict.
+    Returns
+    -------
+    dict
+        The summary also written to ``summary.json``.
     """
-    if n_test < 1:
-        raise ValueError(f"n_test must be >= 1, got {n_test}")
-    t_start = time.perf_counter()
+    if not (np.isfinite(success_radius_m) and success_radius_m > 0):
+        raise ValueError(f"success_radius_m must be > 0, got {success_radius_m}")
+    t0 = time.perf_counter()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng(seed)
-    w, h = AIBO_RESOLUTION
-    results: dict[str, dict] = {}
-    curves = {}
-    panos = {}
-    for kind in ("room", "outdoor"):
-        pano = make_panorama(rng, kind=kind)
-        panos[kind] = pano
-        yaws = rng.uniform(0.0, 360.0, n_test)
-        for exposure in ("none", "mean"):
-            label = f"{kind}/exposure={exposure}"
-            vc = VisualCompass(CompassConfig(exposure=exposure))
-            vc.fit_colors([render_view(pano, Camera(yaw_deg=a), w, h) for a in BODY_YAWS_DEG])
-            _learn(vc, pano, label)
-            entry = {}
-            for illum in (1.0, 0.5):
-                errs = _evaluate(vc, pano, yaws, illum, f"{label} light={illum}")
-                a = np.abs(errs)
-                entry[f"illumination_{illum}"] = {
-                    "median_error_deg": float(np.median(a)),
-                    "within_5deg": float(np.mean(a < 5.0)),
-                    "max_error_deg": float(a.max()),
-                }
-                curves[(kind, exposure, illum)] = (yaws, errs)
-            results[label] = entry
-            if kind == "room" and exposure == "none":
-                test_yaw = float(yaws[0])
-                img = render_view(pano, Camera(yaw_deg=test_yaw), w, h)
-                example = (img, test_yaw, vc.estimate(img, Camera()), vc.headings_deg.copy())
-    summary = {
-        "demo": "visual compass on synthetic panoramas (learn 8 x 45 deg with head pans)",
-        "seed": seed,
-        "frames_per_test": n_test,
-        "frame": f"{w}x{h}",
-        "results": results,
-        "duration_s": round(time.perf_counter() - t_start, 2),
-    }
-    _plot(out / "demo.png", panos, curves, example)
-    summary["duration_s"] = round(time.perf_counter() - t_start, 2)
+    env = gym.make("vc_gym/AiboRoom-v0", scene="robolab", max_episode_steps=10**7)
+    try:
+        agent = ScriptedLearnThenHome(
+            env, LearnThenHomeConfig(learn_time_s=learn_time_s), progress=progress
+        )
+        record = agent.run(seed=seed)
+        summary = {
+            "task": "learn 4 spots 1 m around home, kidnapping, homing (scripted)",
+            "scene": "robolab",
+            "seed": seed,
+            **record.summary(),
+            "success": bool(
+                record.stopped and record.summary()["home_error_m"] <= success_radius_m
+            ),
+            "success_radius_m": success_radius_m,
+            "start_pose": list(record.start) if record.start else None,
+            "odometry_turn_calibration": agent.rot_scale,
+        }
+        _plot(out / "demo.png", record, TopView(env.unwrapped.client, env.unwrapped.scene))
+    finally:
+        env.close()
+    summary["duration_s"] = round(time.perf_counter() - t0, 1)
     tmp = out / ".summary.json.tmp"
     tmp.write_text(json.dumps(summary, indent=2))
     os.replace(tmp, out / "summary.json")
     return summary
 
 
-def _plot(path: Path, panos: dict, curves: dict, example: tuple) -> None:
+def _plot(path: Path, record: EpisodeRecord, top: TopView) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    img, test_yaw, est, headings = example
-    fig = plt.figure(figsize=(13, 9), constrained_layout=True)
-    grid = fig.add_gridspec(3, 3)
-    ax = fig.add_subplot(grid[0, :])
-    pano = panos["room"]
-    ax.imshow(pano.image, extent=(360, 0, pano.elev_bottom_deg, pano.elev_top_deg), aspect="auto")
-    for b in BODY_YAWS_DEG:
-        ax.axvline(b, color="yellow", lw=1, ls="--")
-    ax.axvline(test_yaw, color="red", lw=2, label=f"test frame, true yaw {test_yaw:.1f}°")
-    ax.set_xlabel("azimuth (deg, CCW)")
-    ax.set_ylabel("elevation (deg)")
-    ax.set_title(
-        "Synthetic room panorama; yellow: the 8 learning directions (each ±22.5° head pan)"
+    # world extent of the top view at floor level
+    half = (top.size / 2.0) / top.focal * 40.0
+    cx, cy = top.center
+    extent = (cx - half, cx + half, cy - half, cy + half)
+    fig, (ax, ax2) = plt.subplots(
+        1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1, 1.2]}, constrained_layout=True
     )
-    ax.legend(loc="upper right")
-
-    ax = fig.add_subplot(grid[1, 0])
-    ax.imshow(img)
-    ax.set_title(f"test frame 208×160, estimate {est.heading_deg:.1f}°")
-    ax.axis("off")
-    ax = fig.add_subplot(grid[1, 1:])
-    ax.plot(headings, est.log_likelihood, lw=1)
-    ax.axvline(test_yaw, color="red", lw=1, label="true yaw")
-    ax.set_xlabel("candidate heading (deg)")
-    ax.set_ylabel("log-likelihood ratio")
-    ax.set_title("compass output for the test frame (eq. 16)")
-    ax.legend()
-
-    for i, kind in enumerate(("room", "outdoor")):
-        ax = fig.add_subplot(grid[2, i])
-        for (k, exposure, illum), (yaws, errs) in curves.items():
-            if k != kind:
-                continue
-            marker = "o" if illum == 1.0 else "x"
-            ax.scatter(yaws, errs, s=10, marker=marker, label=f"exposure={exposure}, light×{illum}")
-        ax.set_ylim(-180, 180)
-        ax.set_xlabel("true heading (deg)")
-        ax.set_ylabel("error (deg)")
-        ax.set_title(f"{kind}: heading error per test frame")
-        ax.legend(fontsize=7)
-    ax = fig.add_subplot(grid[2, 2])
-    labels, medians = [], []
-    for (k, exposure, illum), (_, errs) in curves.items():
-        labels.append(f"{k}\n{exposure}\n×{illum}")
-        medians.append(float(np.median(np.abs(errs))))
-    ax.bar(range(len(medians)), medians)
-    ax.set_xticks(range(len(medians)), labels, fontsize=6)
-    ax.set_yscale("log")
-    ax.set_ylabel("median |error| (deg)")
-    ax.set_title("median error")
+    ax.imshow(top.background, extent=extent, alpha=0.85)
+    learn = np.array(record.learn_true)
+    if learn.size:
+        ax.plot(learn[:, 0], learn[:, 1], color="0.8", lw=1, label="learning walk (true)")
+    for name, (x, y) in record.spots.items():
+        ax.plot(x, y, "x", color="yellow", ms=10, mew=3)
+        ax.annotate(name, (x, y), color="yellow", xytext=(5, 5), textcoords="offset points")
+    ax.plot(*record.home, "+", color="white", ms=14, mew=2, label="home")
+    true = np.array(record.true)
+    est = np.array(record.estimated)
+    if true.size:
+        ax.plot(true[:, 0], true[:, 1], color="tab:red", lw=2, label="homing, true")
+        ax.plot(est[:, 0], est[:, 1], color="tab:cyan", lw=1.5, ls="--", label="homing, estimated")
+        ax.plot(true[0, 0], true[0, 1], "o", color="tab:red", ms=8, label="kidnapped to")
+    if record.stop is not None:
+        ax.plot(*record.stop, "*", color="magenta", ms=16, label="stop")
+    ax.set_xlim(extent[0], extent[1])
+    ax.set_ylim(extent[2], extent[3])
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    err = record.summary()["home_error_m"] if record.stop is not None else float("nan")
+    ax.set_title(f"robolab: learn 4 spots, kidnap, walk home (stop {err * 100:.0f} cm from home)")
+    ax.legend(loc="lower left", fontsize=8)
+    if record.heading_error:
+        t = np.arange(len(record.heading_error)) * 0.1
+        ax2.plot(t, np.abs(record.heading_error), color="tab:blue")
+        ax2.set_yscale("log")
+        d = np.hypot(true[:, 0] - record.home[0], true[:, 1] - record.home[1])
+        ax3 = ax2.twinx()
+        ax3.plot(t, d, color="tab:red", lw=1)
+        ax3.set_ylabel("true distance to home (m)", color="tab:red")
+    ax2.set_xlabel("homing time (s)")
+    ax2.set_ylabel("|heading error| (deg)", color="tab:blue")
+    ax2.set_title("orientational filter error and distance to home during homing")
     tmp = path.with_name("." + path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=100)
+    fig.savefig(tmp, dpi=90)
     plt.close(fig)
     os.replace(tmp, path)

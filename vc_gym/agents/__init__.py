@@ -1,0 +1,1 @@
+"""Agents: scripted behaviours of the paper and (later) learned policies."""
