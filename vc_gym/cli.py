@@ -35,6 +35,36 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    if args.agent != "scripted":
+        print(
+            "vc-gym evaluate: error: only --agent scripted is available so far "
+            "(learned agents come with vc-gym train)",
+            file=sys.stderr,
+        )
+        return 2
+    from vc_gym.experiments.evaluate import evaluate_scripted
+
+    result = evaluate_scripted(
+        episodes=args.episodes,
+        seed=args.seed,
+        learn_time_s=args.learn_time,
+        workers=args.workers,
+        out_dir=args.out,
+        progress=not args.json,
+    )
+    if args.json:
+        print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
+    else:
+        print(
+            f"{result['episodes']} episodes: mean stop offset {result['mean_stop_offset_cm']} cm, "
+            f"std {result['std_stop_offset_cm']} cm, mean distance "
+            f"{result['mean_stop_distance_cm']} cm, success {result['success_rate']:.0%} "
+            f"(paper: mean (-22, 12) cm, std (17, 15) cm)"
+        )
+    return 0
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     if args.what == "compass":
         from vc_gym.experiments.bench_compass import bench_compass
@@ -190,6 +220,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PNG", help="filters: save a plot of the tracking run")
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=_cmd_bench)
+
+    p = sub.add_parser(
+        "evaluate",
+        help="repeat the homing experiment: stop positions over many kidnappings",
+        description=(
+            "Run EPISODES learn-then-home episodes in the robolab (seeds SEED, SEED+1, ...) "
+            "and report the stop positions: mean and standard deviation per axis (paper: "
+            "(-22, +12) cm and (17, 15) cm), mean distance and success rate. With --out, "
+            "writes DIR/evaluation.json and DIR/stop_positions.png."
+        ),
+    )
+    p.add_argument("--agent", default="scripted", help="'scripted' (learned agents: later)")
+    p.add_argument("--episodes", type=int, default=33)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--learn-time", type=float, default=5.0, help="seconds per direction")
+    p.add_argument("--workers", type=int, default=2, help="parallel processes")
+    p.add_argument("--out", metavar="DIR", help="folder for evaluation.json and the plot")
+    p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    p.set_defaults(func=_cmd_evaluate)
 
     p = sub.add_parser(
         "render",
