@@ -1,1 +1,22 @@
-"""PyBullet world, robot, camera, Gymnasium envs and wrappers."""
+"""The simulated world: PyBullet scenes, the quadruped, its head camera, Gymnasium envs.
+
+Importing this package imports PyBullet; ``import vc_gym`` alone registers the envs
+without it.
+"""
+
+from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
+from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
+from vc_gym.envs.scenes import SCENES, Scene, build_scene
+
+__all__ = [
+    "LOCOMOTION_MODES",
+    "SCENES",
+    "AiboRoomEnv",
+    "HeadCameraSpec",
+    "OdometryNoise",
+    "Quadruped",
+    "Scene",
+    "build_scene",
+    "render_camera",
+]
