@@ -4,20 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from vc_gym.experiments.output import write_json
+
 __all__ = ["main"]
-
-
-def _write_json(path: str | os.PathLike, obj: object) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name("." + path.name + ".tmp")
-    tmp.write_text(json.dumps(obj, indent=2))
-    os.replace(tmp, path)
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
@@ -107,7 +100,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:
-        _write_json(args.out, result)
+        write_json(args.out, result)
     if args.json:
         print(json.dumps(result))
     return 0
@@ -151,7 +144,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     else:  # pragma: no cover
         raise AssertionError(args.name)
     if args.out:
-        _write_json(args.out, result)
+        write_json(args.out, result)
     if args.json:
         print(json.dumps(result))
     return 0

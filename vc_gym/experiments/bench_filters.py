@@ -28,6 +28,7 @@ from vc_gym.compass import (
     VisualCompass,
 )
 from vc_gym.compass.synthetic_room import make_room, render_room_view
+from vc_gym.experiments.output import save_figure
 from vc_gym.filters.grid import HeadingGridFilter
 from vc_gym.filters.kalman import KalmanHeadingFilter
 from vc_gym.filters.particle import ParticleFilter
@@ -228,8 +229,4 @@ def _plot(path: Path, track: dict) -> None:
         "Heading tracking with the visual compass: walking up to 1 m from the learning spot, "
         "15 % of frames occluded"
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name("." + path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    os.replace(tmp, path)
+    save_figure(fig, path, dpi=100)

@@ -7,7 +7,6 @@ filters (paper 4.3, 5.2). Writes ``summary.json`` and ``demo.png``.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from pathlib import Path
@@ -18,6 +17,7 @@ import numpy as np
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.agents.scripted import EpisodeRecord, LearnThenHomeConfig, ScriptedLearnThenHome
 from vc_gym.envs.top_view import TopView
+from vc_gym.experiments.output import save_figure, write_json
 
 __all__ = ["run_demo"]
 
@@ -76,9 +76,7 @@ def run_demo(
     finally:
         env.close()
     summary["duration_s"] = round(time.perf_counter() - t0, 1)
-    tmp = out / ".summary.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=2))
-    os.replace(tmp, out / "summary.json")
+    write_json(out / "summary.json", summary)
     return summary
 
 
@@ -129,7 +127,4 @@ def _plot(path: Path, record: EpisodeRecord, top: TopView) -> None:
     ax2.set_xlabel("homing time (s)")
     ax2.set_ylabel("|heading error| (deg)", color="tab:blue")
     ax2.set_title("orientational filter error and distance to home during homing")
-    tmp = path.with_name("." + path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=90)
-    plt.close(fig)
-    os.replace(tmp, path)
+    save_figure(fig, path, dpi=90)

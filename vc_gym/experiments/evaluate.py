@@ -10,13 +10,14 @@ figure 5 (left).
 
 from __future__ import annotations
 
-import json
 import multiprocessing as mp
 import os
 import time
 from pathlib import Path
 
 import numpy as np
+
+from vc_gym.experiments.output import save_figure, write_json
 
 __all__ = ["evaluate_scripted", "PAPER_MEAN_CM", "PAPER_STD_CM"]
 
@@ -99,9 +100,7 @@ def evaluate_scripted(
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        tmp = out / ".evaluation.json.tmp"
-        tmp.write_text(json.dumps(summary, indent=2))
-        os.replace(tmp, out / "evaluation.json")
+        write_json(out / "evaluation.json", summary)
         _plot(out / "stop_positions.png", offsets, summary)
     return summary
 
@@ -132,7 +131,4 @@ def _plot(path: Path, offsets_cm: np.ndarray, summary: dict) -> None:
         f"mean distance {summary['mean_stop_distance_cm']:.0f} cm"
     )
     ax.legend(fontsize=7, loc="upper right")
-    tmp = path.with_name("." + path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    os.replace(tmp, path)
+    save_figure(fig, path, dpi=100)

@@ -8,7 +8,6 @@ and ``synthetic_compass.png``.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from pathlib import Path
@@ -19,6 +18,7 @@ from tqdm import tqdm
 from vc_gym.angles import wrap180
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
 from vc_gym.compass.synthetic import Panorama, make_panorama, render_view
+from vc_gym.experiments.output import save_figure, write_json
 
 __all__ = ["run_synthetic_compass"]
 
@@ -95,9 +95,7 @@ def run_synthetic_compass(
     }
     _plot(out / "synthetic_compass.png", panos, curves, example)
     summary["duration_s"] = round(time.perf_counter() - t_start, 2)
-    tmp = out / ".synthetic_compass.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=2))
-    os.replace(tmp, out / "synthetic_compass.json")
+    write_json(out / "synthetic_compass.json", summary)
     return summary
 
 
@@ -157,7 +155,4 @@ def _plot(path: Path, panos: dict, curves: dict, example: tuple) -> None:
     ax.set_yscale("log")
     ax.set_ylabel("median |error| (deg)")
     ax.set_title("median error")
-    tmp = path.with_name("." + path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    os.replace(tmp, path)
+    save_figure(fig, path, dpi=100)
