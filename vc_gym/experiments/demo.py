@@ -60,14 +60,13 @@ def run_demo(
             env, LearnThenHomeConfig(learn_time_s=learn_time_s), progress=progress
         )
         record = agent.run(seed=seed)
+        result = record.summary()
         summary = {
             "task": "learn 4 spots 1 m around home, kidnapping, homing (scripted)",
             "scene": "robolab",
             "seed": seed,
-            **record.summary(),
-            "success": bool(
-                record.stopped and record.summary()["home_error_m"] <= success_radius_m
-            ),
+            **result,
+            "success": bool(record.stopped and result["home_error_m"] <= success_radius_m),
             "success_radius_m": success_radius_m,
             "start_pose": list(record.start) if record.start else None,
             "odometry_turn_calibration": agent.rot_scale,
