@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassConfig, VisualCompass
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.compass.synthetic import Panorama, make_panorama, render_view
+from vc_gym.compass.synthetic_room import Room, make_room, render_room_view
 from vc_gym.experiments.real_data import default_real_data_dir
 
 #: Yaws of the learning frames: 8 body directions x 3 head pans (paper 4.3).
@@ -41,6 +42,42 @@ def make_learned_compass():
 @pytest.fixture(scope="session")
 def room_compass(room_pano: Panorama) -> VisualCompass:
     return learned_compass(room_pano)
+
+
+#: Four training spots 1 m around home, as in the paper's homing experiment (5.2).
+ROOM_SPOTS = {"east": (1.0, 0.0), "north": (0.0, 1.0), "west": (-1.0, 0.0), "south": (0.0, -1.0)}
+
+
+@pytest.fixture(scope="session")
+def synthetic_room() -> Room:
+    """A ray-cast room with real parallax (seeded)."""
+    return make_room(np.random.default_rng(3))
+
+
+@pytest.fixture(scope="session")
+def room_atlas(synthetic_room: Room) -> CompassAtlas:
+    """Compasses learned at ROOM_SPOTS in :func:`synthetic_room`, normalised at (0, 0)."""
+    colors = None
+    spots = {}
+    for name, (x, y) in ROOM_SPOTS.items():
+        vc = VisualCompass(CompassConfig(), colors)
+        if colors is None:
+            vc.fit_colors(
+                [
+                    render_room_view(synthetic_room, 0.0, 0.0, Camera(yaw_deg=a))
+                    for a in range(0, 360, 45)
+                ]
+            )
+            colors = vc.colors
+        for a in LEARN_YAWS:
+            vc.learn(render_room_view(synthetic_room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+        spots[name] = ((x, y), vc)
+    atlas = CompassAtlas(spots, home="centre")
+    home = [
+        render_room_view(synthetic_room, 0.0, 0.0, Camera(yaw_deg=a)) for a in range(0, 360, 10)
+    ]
+    atlas.normalize(home, [Camera()] * len(home))
+    return atlas
 
 
 @pytest.fixture(scope="session")

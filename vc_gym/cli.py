@@ -29,19 +29,14 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    if args.agent != "scripted":
-        print(
-            "vc-gym evaluate: error: only --agent scripted is available so far "
-            "(learned agents come with vc-gym train)",
-            file=sys.stderr,
-        )
-        return 2
-    from vc_gym.experiments.evaluate import evaluate_scripted
+    from vc_gym.experiments.evaluate import evaluate_agent
 
-    result = evaluate_scripted(
+    result = evaluate_agent(
+        agent=args.agent,
         episodes=args.episodes,
         seed=args.seed,
         learn_time_s=args.learn_time,
+        relearn=args.relearn,
         workers=args.workers,
         out_dir=args.out,
         progress=not args.json,
@@ -55,6 +50,37 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
             f"{result['mean_stop_distance_cm']} cm, success {result['success_rate']:.0%} "
             f"(paper: mean (-22, 12) cm, std (17, 15) cm)"
         )
+    return 0
+
+
+def _cmd_train(args: argparse.Namespace) -> int:
+    from vc_gym.agents.learned import TrainConfig, train
+
+    config = TrainConfig(
+        algo=args.algo,
+        timesteps=args.timesteps,
+        n_envs=args.n_envs,
+        seed=args.seed,
+        scene=args.scene,
+        learn_time_s=args.learn_time,
+        vec_env="dummy" if args.n_envs == 1 else "subproc",
+    )
+    s = train(config, args.out, progress=not args.json)
+    if args.json:
+        print(json.dumps(s))
+    else:
+        rate = s["recent_success_rate"]
+        print(
+            f"trained {config.algo} for {config.timesteps} decisions in {s['duration_s']:.0f} s "
+            f"({s['episodes']} episodes"
+            + (
+                f"; last 50: success {rate:.0%}, mean stop error "
+                f"{s['recent_mean_stop_error_m'] * 100:.0f} cm)"
+                if rate is not None
+                else ")"
+            )
+        )
+        print(f"wrote {s['model']} (evaluate it: vc-gym evaluate --agent {s['model']})")
     return 0
 
 
@@ -218,13 +244,27 @@ def build_parser() -> argparse.ArgumentParser:
         "evaluate",
         help="repeat the homing experiment: stop positions over many kidnappings",
         description=(
-            "Run EPISODES learn-then-home episodes in the robolab (seeds SEED, SEED+1, ...) "
-            "and report the stop positions: mean and standard deviation per axis (paper: "
-            "(-22, +12) cm and (17, 15) cm), mean distance and success rate. With --out, "
-            "writes DIR/evaluation.json and DIR/stop_positions.png."
+            "The paper's homing experiment on vc_gym/LearnThenHome-v0 in the robolab: the "
+            "robot learns the place once (scripted learning, seed SEED), then is kidnapped "
+            "EPISODES times (seeds SEED+1, ...) and walks home with the scripted agent or a "
+            "trained one (--agent DIR/model.zip from vc-gym train); it must stand still 5 s "
+            "to stop. Reports the stop positions: mean and standard deviation per axis "
+            "(paper: (-22, +12) cm and (17, 15) cm), mean distance and success rate. With "
+            "--out, writes DIR/evaluation.json and DIR/stop_positions.png."
         ),
     )
-    p.add_argument("--agent", default="scripted", help="'scripted' (learned agents: later)")
+    p.add_argument(
+        "--agent",
+        default="scripted",
+        metavar="scripted|pretrained|DIR/model.zip",
+        help="the scripted homing agent, the shipped PPO policy, or a model from vc-gym train",
+    )
+    p.add_argument(
+        "--relearn",
+        choices=["scene", "episode"],
+        default="scene",
+        help="learn once (paper) or before every kidnapping",
+    )
     p.add_argument("--episodes", type=int, default=33)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--learn-time", type=float, default=5.0, help="seconds per direction")
@@ -232,6 +272,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", help="folder for evaluation.json and the plot")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_evaluate)
+
+    p = sub.add_parser(
+        "train",
+        help="train a learned homing agent (stable-baselines3) on the compass' outputs",
+        description=(
+            "Train PPO (default) or SAC on vc_gym/LearnThenHome-v0 wrapped in "
+            "CompassObservation: the agent sees the filters' heading and position estimates "
+            "and the spots' goodness (never the image or the true pose) and acts by walking, "
+            "turning and deciding to stop. Environments run in parallel worker processes "
+            "(SubprocVecEnv); each learns the place once (scripted learning) and is then "
+            "kidnapped again and again. Writes DIR/model.zip, DIR/config.json, "
+            "DIR/train_log.json and DIR/learning_curve.png."
+        ),
+    )
+    p.add_argument("--algo", choices=["ppo", "sac"], default="ppo", help="algorithm")
+    p.add_argument("--timesteps", type=int, default=60_000, help="agent decisions to train for")
+    p.add_argument("--out", default="vc_gym_agent", metavar="DIR", help="output folder")
+    p.add_argument("--n-envs", type=int, default=2, help="parallel environments (processes)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--scene", default="robolab", help="scene to train in")
+    p.add_argument("--learn-time", type=float, default=5.0, help="seconds per learning direction")
+    p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    p.set_defaults(func=_cmd_train)
 
     p = sub.add_parser(
         "render",

@@ -30,13 +30,13 @@ def test_short_episode_ends_at_home(episode):
 def test_loop_closure_calibrates_odometry_turns():
     env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
     agent = ScriptedLearnThenHome(env, LearnThenHomeConfig(learn_time_s=0.5), progress=False)
-    agent.obs, agent.info = env.reset(seed=4, options={"pose": (0.0, 0.0, 0.0)})
+    agent.learner.obs, agent.learner.info = env.reset(seed=4, options={"pose": (0.0, 0.0, 0.0)})
     true_scale = agent.u.robot.odometry_scale[1]  # drawn at reset, for this check only
-    agent._learn_home(steps=5)
+    agent.learner._learn_home(steps=5)
     env.close()
     assert abs(true_scale - 1.0) > 0.005  # there is an error to calibrate
     # the odometry over-reports turns by true_scale; the calibration undoes it
-    assert agent.rot_scale * true_scale == pytest.approx(1.0, abs=0.02)
+    assert agent.learner.rot_scale * true_scale == pytest.approx(1.0, abs=0.02)
 
 
 def test_record_has_trajectories(episode):

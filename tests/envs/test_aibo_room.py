@@ -29,9 +29,13 @@ ALLOWED_WARNINGS = (
 )
 
 
+#: Per-env keyword arguments that keep the tests fast (a short scripted learning phase).
+FAST = {"vc_gym/LearnThenHome-v0": {"learn_time_s": 0.2}}
+
+
 def make(env_id, **kwargs):
     kwargs.setdefault("camera", SMALL)
-    return gym.make(env_id, **kwargs)
+    return gym.make(env_id, **{**FAST.get(env_id, {}), **kwargs})
 
 
 def _filtered(record):

@@ -1,25 +1,40 @@
-"""`vc-gym evaluate` end to end with a tiny budget."""
+"""`vc-gym evaluate` end to end with a tiny budget (learned agents: tests/agents)."""
 
 from __future__ import annotations
 
 import json
 
+import pytest
+
 from vc_gym.cli import main
-from vc_gym.experiments.evaluate import evaluate_scripted
+from vc_gym.experiments.evaluate import evaluate_agent
 
 
 def test_evaluate_scripted_summarises_stops(tmp_path):
-    r = evaluate_scripted(
-        episodes=2, seed=3, learn_time_s=0.3, workers=1, out_dir=tmp_path, progress=False
+    r = evaluate_agent(
+        episodes=2, seed=3, learn_time_s=0.2, workers=2, out_dir=tmp_path, progress=False
     )
-    assert len(r["per_episode"]) == 2
+    assert [e["seed"] for e in r["per_episode"]] == [4, 5]
     assert len(r["mean_stop_offset_cm"]) == 2 and len(r["std_stop_offset_cm"]) == 2
     assert 0.0 <= r["success_rate"] <= 1.0
+    for ep in r["per_episode"]:
+        assert ep["stopped"] or ep["timed_out"]
+        assert ep["home_error_m"] == pytest.approx(
+            (ep["stop_offset_m"][0] ** 2 + ep["stop_offset_m"][1] ** 2) ** 0.5
+        )
     saved = json.loads((tmp_path / "evaluation.json").read_text())
-    assert saved["episodes"] == 2
+    assert saved["episodes"] == 2 and saved["protocol"].startswith("learn once")
     assert (tmp_path / "stop_positions.png").read_bytes()[:4] == b"\x89PNG"
 
 
-def test_evaluate_rejects_unknown_agent(capsys):
+def test_evaluate_rejects_a_missing_model(capsys):
     assert main(["evaluate", "--agent", "ppo_model.zip", "--episodes", "1"]) == 2
-    assert "scripted" in capsys.readouterr().err
+    assert "model" in capsys.readouterr().err
+
+
+def test_evaluate_rejects_bad_numbers():
+
+    with pytest.raises(ValueError):
+        evaluate_agent(episodes=0)
+    with pytest.raises(ValueError):
+        evaluate_agent(relearn="sometimes")

@@ -22,9 +22,17 @@ from tqdm import tqdm
 from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.compass.sensors import interp_circular
-from vc_gym.filters import HeadingGridFilter, TranslationalFilter
+from vc_gym.filters import HeadingGridFilter
 
-__all__ = ["LearnThenHomeConfig", "ScriptedLearnThenHome", "EpisodeRecord"]
+__all__ = [
+    "EpisodeRecord",
+    "LearnThenHomeConfig",
+    "RobotFell",
+    "ScriptedHomingPolicy",
+    "ScriptedLearnThenHome",
+    "ScriptedLearner",
+    "kidnap_pose",
+]
 
 SPOT_NAMES = ("east", "north", "west", "south")
 
@@ -119,8 +127,14 @@ class EpisodeRecord:
         }
 
 
-class ScriptedLearnThenHome:
-    """Runs the paper's learn-then-home episode on a ``vc_gym/AiboRoom-v0`` env.
+class ScriptedLearner:
+    """The paper's learning behaviour on a ``vc_gym/AiboRoom-v0`` env (4.3, 5.2).
+
+    The robot must stand at home facing the world's 0° (its frame is then the world
+    frame). :meth:`learn` turns a full circle there (colour classes, home map, odometry
+    turn calibration by loop closure), learns four spots ``spot_distance_m`` around
+    home (8 × 45°, ``learn_time_s`` each, head scanning), walks back and normalises
+    the spots' goodness at home. It uses camera frames, head angles and odometry only.
 
     Parameters
     ----------
@@ -129,7 +143,7 @@ class ScriptedLearnThenHome:
     config : LearnThenHomeConfig, optional
         Behaviour parameters.
     progress : bool
-        Show a progress bar per phase.
+        Show a progress bar while learning the spots.
     """
 
     def __init__(self, env, config: LearnThenHomeConfig | None = None, progress: bool = True):
@@ -146,12 +160,9 @@ class ScriptedLearnThenHome:
         self.turn_accum = 0.0
         self.home_compass: VisualCompass | None = None
         self.learn_filter: HeadingGridFilter | None = None
-        self.atlas: CompassAtlas | None = None
-        self.heading_filter: HeadingGridFilter | None = None
         self.obs: dict | None = None
         self.info: dict | None = None
 
-    # ------------------------------------------------------------------ low level
     def _act(self, forward=0.0, turn=0.0, pan=0.0) -> None:
         u = self.u
         a = np.array(
@@ -170,7 +181,7 @@ class ScriptedLearnThenHome:
         ]
         self.belief[2] = wrap360(self.belief[2])
         if terminated:
-            raise _Fell()
+            raise RobotFell()
         if self.learn_filter is not None and self.home_compass is not None:
             # keep the heading belief on the home map while learning elsewhere
             f = self.learn_filter
@@ -206,13 +217,27 @@ class ScriptedLearnThenHome:
                 continue
             self._act(forward=min(0.3, 1.5 * dist), turn=float(np.clip(3.0 * err, -60, 60)))
 
-    # ------------------------------------------------------------------ phases
-    def learn(self, record: EpisodeRecord) -> None:
-        """Learning phase: four spots around home, then normalisation at home."""
+    def spots(self) -> dict[str, tuple[float, float]]:
+        """The four training spots around home (world metres)."""
+        d = self.config.spot_distance_m
+        return {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
+
+    def learn(self, record: EpisodeRecord | None = None) -> CompassAtlas:
+        """Learning phase: home turn, four spots, normalisation at home.
+
+        Returns the normalised atlas (home ``"home"`` at ``(0, 0)``); the true poses of
+        the spot-learning frames go to ``record.learn_true`` (for plots only).
+
+        Raises
+        ------
+        RobotFell
+            If the robot falls (only with ``locomotion="dynamic"``).
+        """
         cfg = self.config
+        self.belief = np.zeros(3)
+        self.learn_filter = None
         steps = max(1, int(round(cfg.learn_time_s / self.dt)))
-        d = cfg.spot_distance_m
-        spots = {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
+        spots = self.spots()
         self._learn_home(steps)
         colors = self.home_compass.colors
         compasses = {}
@@ -228,19 +253,21 @@ class ScriptedLearnThenHome:
                     self._act(pan=self._next_pan())
                     pan = float(self.obs["head"][0])
                     vc.learn(self.obs["image"], self.camera.replace(yaw_deg=self.belief[2] + pan))
-                    record.learn_true.append(tuple(self.info["pose"]))
+                    if record is not None:
+                        record.learn_true.append(tuple(self.info["pose"]))
                     bar.update()
             compasses[name] = (spots[name], vc)
         bar.close()
         self._walk_to(0.0, 0.0)
-        self.atlas = CompassAtlas(compasses, home="home", home_position=(0.0, 0.0))
+        atlas = CompassAtlas(compasses, home="home", home_position=(0.0, 0.0))
         imgs, cams = [], []
         for k in range(cfg.normalise_directions):
             self._turn_to(360.0 * k / cfg.normalise_directions)
             self._act()
             imgs.append(self.obs["image"])
             cams.append(self.camera)
-        self.atlas.normalize(imgs, cams)
+        atlas.normalize(imgs, cams)
+        return atlas
 
     def _learn_home(self, steps: int) -> None:
         """Learn the home map in a full turn and calibrate the odometry's turns.
@@ -287,100 +314,194 @@ class ScriptedLearnThenHome:
         )
         self.learn_filter.reset(self.belief[2], 2.0)
 
-    def _heading_ll(self, atlas_est, pan: float) -> np.ndarray:
-        best = max(atlas_est.goodness, key=atlas_est.goodness.get)
-        ll = atlas_est.estimates[best].log_likelihood
-        step = self.atlas.compasses[0].config.heading_step_deg
-        return interp_circular(ll, step, self.heading_filter.headings_deg + pan)
+
+class ScriptedHomingPolicy:
+    """The paper's homing behaviour on :class:`~vc_gym.envs.CompassObservation` outputs.
+
+    First stand still (head scanning) for ``settle_time_s`` and until the heading
+    spread is below ``max_spread_deg``, so the filters settle; then turn towards the
+    estimated home and walk (slower when close); stand still, scanning with the head,
+    once the estimate is within ``home_tolerance_m`` of home. Uses only
+    ``home_vector`` and ``heading_spread`` of the observation.
+
+    Parameters
+    ----------
+    config : LearnThenHomeConfig, optional
+        ``home_tolerance_m`` and ``head_scan_deg`` are used.
+    dt_s : float
+        Control period of the env (seconds per step).
+    max_forward : float
+        The env's top forward speed (m/s) that an action of 1 commands.
+    max_turn_deg_s : float
+        The env's top turn rate (deg/s) that an action of 1 commands.
+    settle_time_s : float
+        Time to stand still at the start of homing.
+    max_spread_deg : float
+        Stand still while the heading belief is wider than this.
+    rearm_factor : float
+        Once within ``home_tolerance_m``, walk again only when the estimate leaves
+        ``rearm_factor × home_tolerance_m`` (the estimate jitters by ~0.1 m as the head
+        scans; without this hysteresis the robot shuffles around home and never stops).
+    """
+
+    def __init__(
+        self,
+        config: LearnThenHomeConfig | None = None,
+        dt_s: float = 0.1,
+        max_forward: float = 0.5,
+        max_turn_deg_s: float = 86.0,
+        settle_time_s: float = 2.0,
+        max_spread_deg: float = 30.0,
+        rearm_factor: float = 2.5,
+    ):
+        for name, v in (
+            ("dt_s", dt_s),
+            ("max_forward", max_forward),
+            ("max_turn_deg_s", max_turn_deg_s),
+            ("max_spread_deg", max_spread_deg),
+            ("rearm_factor", rearm_factor),
+        ):
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        if not (math.isfinite(settle_time_s) and settle_time_s >= 0):
+            raise ValueError(f"settle_time_s must be finite and >= 0, got {settle_time_s!r}")
+        self.config = config if config is not None else LearnThenHomeConfig()
+        self.dt_s = float(dt_s)
+        self.max_forward = float(max_forward)
+        self.max_turn_deg_s = float(max_turn_deg_s)
+        self.settle_time_s = float(settle_time_s)
+        self.max_spread_deg = float(max_spread_deg)
+        self.rearm_factor = float(rearm_factor)
+        if self.rearm_factor < 1:
+            raise ValueError(f"rearm_factor must be >= 1, got {rearm_factor!r}")
+        self.reset()
+
+    def reset(self) -> None:
+        """Start of a homing episode."""
+        self._t = 0
+        self._scan_i = 0
+        self._arrived = False
+
+    def predict(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        """The action (``Box(-1, 1, (5,))`` of the env) for one observation."""
+        fwd_home, left_home = (float(v) for v in obs["home_vector"])
+        spread = float(obs["heading_spread"][0])
+        settling = self._t * self.dt_s < self.settle_time_s or spread > self.max_spread_deg
+        self._t += 1
+        dist = math.hypot(fwd_home, left_home)
+        # hysteresis: once arrived, only a clearly wrong estimate makes the robot move
+        tol = self.config.home_tolerance_m
+        self._arrived = dist <= (self.rearm_factor if self._arrived else 1.0) * tol
+        forward, turn = 0.0, 0.0
+        if not settling and not self._arrived:
+            err = math.degrees(math.atan2(left_home, fwd_home))
+            turn = float(np.clip(2.5 * err, -60.0, 60.0))
+            forward = 0.0 if abs(err) > 30 else min(0.25, 0.8 * dist)
+        pan = 0.0
+        if forward == 0.0:
+            pans = self.config.head_scan_deg
+            self._scan_i = (self._scan_i + 1) % len(pans)
+            pan = pans[self._scan_i]
+        a = [forward / self.max_forward, 0.0, turn / self.max_turn_deg_s, pan / 90.0, 0.0]
+        return np.clip(np.array(a, np.float32), -1.0, 1.0)
+
+    @staticmethod
+    def is_still(action: np.ndarray, threshold: float = 0.05) -> bool:
+        """No body motion commanded (the head may move)."""
+        return bool(np.all(np.abs(np.asarray(action)[:3]) <= threshold))
+
+
+class ScriptedLearnThenHome:
+    """Runs the paper's learn-then-home episode on a ``vc_gym/AiboRoom-v0`` env.
+
+    :class:`ScriptedLearner` learns the place, then the robot is kidnapped (env reset
+    to the start pose) and :class:`ScriptedHomingPolicy` walks home on the outputs of
+    a :class:`~vc_gym.envs.CompassObservation` wrapper until it has stood still for
+    ``stop_time_s``. Every step's true and estimated pose is recorded.
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        An ``AiboRoomEnv`` (or a wrapper of one) with the default head camera.
+    config : LearnThenHomeConfig, optional
+        Behaviour parameters.
+    progress : bool
+        Show a progress bar per phase.
+    """
+
+    def __init__(self, env, config: LearnThenHomeConfig | None = None, progress: bool = True):
+        self.env = env
+        self.u = env.unwrapped
+        self.config = config if config is not None else LearnThenHomeConfig()
+        self.progress = progress
+        self.dt = self.u.control_dt
+        self.learner = ScriptedLearner(env, self.config, progress)
+        self.atlas: CompassAtlas | None = None
 
     def home(self, record: EpisodeRecord, start_pose: tuple[float, float, float]) -> None:
         """Kidnap to ``start_pose`` and walk home with the filters (paper 5.2)."""
+        from vc_gym.envs.compass_observation import CompassObservation
+
         cfg = self.config
         assert self.atlas is not None
-        self.obs, self.info = self.env.reset(options={"pose": start_pose})
+        env = CompassObservation(self.env, atlas=self.atlas, half_life_s=cfg.half_life_s)
+        robot = self.u.robot
+        policy = ScriptedHomingPolicy(
+            cfg, self.dt, max_forward=robot.max_forward, max_turn_deg_s=robot.max_turn_deg_s
+        )
+        obs, info = env.reset(options={"pose": start_pose})
         record.start = start_pose
-        hf = HeadingGridFilter(rule="mixing", half_life_s=cfg.half_life_s, dt_s=self.dt)
-        tf = TranslationalFilter(self.atlas.positions, half_life_s=cfg.half_life_s, dt_s=self.dt)
-        self.heading_filter = hf
         still_steps = 0
         need_still = int(round(cfg.stop_time_s / self.dt))
         n_steps = int(round(cfg.max_homing_s / self.dt))
-        forward, turn = 0.0, 0.0
-        for t in tqdm(range(n_steps), desc="homing", unit="step", disable=not self.progress):
-            pan = self._next_pan() if forward == 0.0 else 0.0
-            a = np.array(
-                [
-                    forward / self.u.robot.max_forward,
-                    0.0,
-                    turn / self.u.robot.max_turn_deg_s,
-                    pan / 90.0,
-                    0.0,
-                ],
-                np.float32,
-            )
-            self.obs, _, terminated, _, self.info = self.env.step(a)
+        for _ in tqdm(range(n_steps), desc="homing", unit="step", disable=not self.progress):
+            action = policy.predict(obs)
+            still_steps = still_steps + 1 if policy.is_still(action) else 0
+            if still_steps > need_still:
+                record.stopped = True
+                break
+            obs, _, terminated, _, info = env.step(action)
             if terminated:
                 record.fell = True
                 break
-            dx, dy, dth = (float(v) for v in self.obs["odometry"])
-            hf.predict(dth, noise_deg=0.5 + 0.1 * abs(dth))
-            est = self.atlas.estimate_position(self.obs["image"], self.camera)
-            head_pan = float(self.obs["head"][0])
-            hf.update_log_likelihood(self._heading_ll(est, head_pan))
-            heading = hf.estimate().heading_deg
-            th = math.radians(heading)
-            tf.predict(dx * math.cos(th) - dy * math.sin(th), dx * math.sin(th) + dy * math.cos(th))
-            tf.update_position(est.position)
-            x, y = tf.position
-            true = tuple(float(v) for v in self.info["pose"])
+            c, s = (float(v) for v in obs["heading"])
+            heading = math.degrees(math.atan2(s, c)) % 360.0
+            true = tuple(float(v) for v in info["pose"])
             record.true.append(true)
-            record.estimated.append((x, y, heading))
+            record.estimated.append((*(float(v) for v in obs["position"]), heading))
             record.heading_error.append(float(wrap180(heading - true[2])))
-            # control: first settle the heading belief, then drive to where τ̂ = home
-            to_home = (-x, -y)
-            dist = math.hypot(*to_home)
-            if t * self.dt < 2.0 or hf.estimate().spread_deg > 30.0:
-                forward, turn = 0.0, 0.0
-            elif dist > cfg.home_tolerance_m:
-                err = float(wrap180(math.degrees(math.atan2(to_home[1], to_home[0])) - heading))
-                turn = float(np.clip(2.5 * err, -60.0, 60.0))
-                forward = 0.0 if abs(err) > 30 else min(0.25, 0.8 * dist)
-            else:
-                forward, turn = 0.0, 0.0
-            moving = forward != 0.0 or turn != 0.0
-            still_steps = 0 if moving else still_steps + (t * self.dt >= 2.0)
-            if still_steps >= need_still:
-                record.stopped = True
-                break
         record.stop = (record.true[-1][0], record.true[-1][1]) if record.true else None
-        record.sim_time_s = float(self.info["sim_time"])
+        record.sim_time_s = float(info["sim_time"])
 
     def run(self, seed: int, start_pose: tuple[float, float, float] | None = None) -> EpisodeRecord:
         """One full episode: learn at home (the robot starts there facing 0°), then
         kidnapping to ``start_pose`` (default: random on the field) and homing."""
-        d = self.config.spot_distance_m
-        record = EpisodeRecord(
-            spots={"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)},
-            home=(0.0, 0.0),
+        record = EpisodeRecord(spots=self.learner.spots(), home=(0.0, 0.0))
+        self.learner.obs, self.learner.info = self.env.reset(
+            seed=seed, options={"pose": (0.0, 0.0, 0.0)}
         )
-        self.obs, self.info = self.env.reset(seed=seed, options={"pose": (0.0, 0.0, 0.0)})
-        self.belief = np.zeros(3)
         try:
-            self.learn(record)
+            self.atlas = self.learner.learn(record)
             if start_pose is None:
-                rng = np.random.default_rng(seed + 1)
-                fx0, fx1, fy0, fy1 = self.u.scene.field_bounds
-                start_pose = (
-                    float(rng.uniform(fx0 + 0.5, fx1 - 0.5)),
-                    float(rng.uniform(fy0 + 0.5, fy1 - 0.5)),
-                    float(rng.uniform(0.0, 360.0)),
-                )
+                start_pose = kidnap_pose(np.random.default_rng(seed + 1), self.u.scene.field_bounds)
             self.home(record, start_pose)
-        except _Fell:
+        except RobotFell:
             record.fell = True
-            record.stop = tuple(self.info["pose"][:2])
+            record.stop = tuple(self.learner.info["pose"][:2])
         return record
 
 
-class _Fell(Exception):
+def kidnap_pose(
+    rng: np.random.Generator, field_bounds: tuple[float, float, float, float], margin: float = 0.5
+) -> tuple[float, float, float]:
+    """A random pose on the field, ``margin`` metres inside its edges, random heading."""
+    fx0, fx1, fy0, fy1 = field_bounds
+    return (
+        float(rng.uniform(fx0 + margin, fx1 - margin)),
+        float(rng.uniform(fy0 + margin, fy1 - margin)),
+        float(rng.uniform(0.0, 360.0)),
+    )
+
+
+class RobotFell(Exception):
     """The robot fell during the learning phase."""

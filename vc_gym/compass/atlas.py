@@ -129,7 +129,16 @@ class CompassAtlas:
 
     def scores(self, image: np.ndarray, camera: Camera) -> tuple[np.ndarray, list[CompassEstimate]]:
         """Raw per-spot scores (mean log-probability per term) and estimates."""
-        ests = [vc.estimate(image, camera) for vc in self.compasses]
+        first = self.compasses[0]
+        if all(vc.colors is first.colors for vc in self.compasses):
+            # one colour set and config (the usual case): the image's sector features
+            # are the same for every spot, so compute them once
+            for vc in self.compasses:
+                vc._checked(image, camera, need_map=True)
+            features = first._sector_features(image, camera)
+            ests = [vc._estimate_of(*features) for vc in self.compasses]
+        else:
+            ests = [vc.estimate(image, camera) for vc in self.compasses]
         return np.array([e.score for e in ests]), ests
 
     def normalize(

@@ -12,11 +12,16 @@ import math
 
 import numpy as np
 
-from vc_gym.compass.atlas import CompassAtlas
+from vc_gym.compass.atlas import AtlasEstimate, CompassAtlas
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.visual_compass import VisualCompass
 
-__all__ = ["CompassHeadingSensor", "AtlasPoseSensor", "interp_circular"]
+__all__ = [
+    "AtlasPoseSensor",
+    "CompassHeadingSensor",
+    "best_spot_heading_log_likelihood",
+    "interp_circular",
+]
 
 
 def interp_circular(values: np.ndarray, step_deg: float, query_deg: np.ndarray) -> np.ndarray:
@@ -33,6 +38,30 @@ def interp_circular(values: np.ndarray, step_deg: float, query_deg: np.ndarray) 
     with np.errstate(invalid="ignore"):
         out = np.where(frac == 0.0, a, (1.0 - frac) * a + frac * b)
     return out
+
+
+def best_spot_heading_log_likelihood(
+    atlas: CompassAtlas, estimate: AtlasEstimate, headings_deg: np.ndarray
+) -> np.ndarray:
+    """Heading log-likelihood (eq. 16) of the spot that fits an image best (eq. 28).
+
+    Parameters
+    ----------
+    atlas : CompassAtlas
+        The atlas that produced ``estimate``.
+    estimate : AtlasEstimate
+        ``atlas.estimate_position(image, camera)`` for one image.
+    headings_deg : numpy.ndarray
+        Camera headings to evaluate (body heading plus head pan), degrees.
+
+    Returns
+    -------
+    numpy.ndarray
+        The best spot's log-likelihood interpolated at ``headings_deg``.
+    """
+    best = max(estimate.goodness, key=estimate.goodness.get)
+    step = atlas.compasses[0].config.heading_step_deg
+    return interp_circular(estimate.estimates[best].log_likelihood, step, headings_deg)
 
 
 class CompassHeadingSensor:
@@ -121,9 +150,7 @@ class AtlasPoseSensor:
         if p.ndim != 2 or p.shape[1] != 3:
             raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
         est = self.atlas.estimate_position(observation, self.camera)
-        best = max(est.goodness, key=est.goodness.get)
-        ll_heading = est.estimates[best].log_likelihood
-        step = self.atlas.compasses[0].config.heading_step_deg
         d2 = (p[:, 0] - est.position[0]) ** 2 + (p[:, 1] - est.position[1]) ** 2
-        heading = interp_circular(ll_heading, step, p[:, 2]) / self.heading_temperature
+        heading = best_spot_heading_log_likelihood(self.atlas, est, p[:, 2])
+        heading = heading / self.heading_temperature
         return heading - 0.5 * d2 / self.position_noise_m**2

@@ -453,7 +453,12 @@ class VisualCompass:
         See :class:`CompassEstimate` for the meaning of each number (eq. 25-28).
         """
         self._checked(image, camera, need_map=True)
-        geom, counts, total = self._sector_features(image, camera)
+        return self._estimate_of(*self._sector_features(image, camera))
+
+    def _estimate_of(
+        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
+    ) -> CompassEstimate:
+        """:meth:`estimate` from sector features (shared by compasses with one colour set)."""
         ll = self._log_likelihood_of(geom, counts, total)
         n_h = ll.size
         best = int(np.argmax(ll))

@@ -5,7 +5,9 @@ without it.
 """
 
 from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
+from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
 from vc_gym.envs.scenes import SCENES, Scene, build_scene
 
@@ -13,7 +15,10 @@ __all__ = [
     "LOCOMOTION_MODES",
     "SCENES",
     "AiboRoomEnv",
+    "CompassObservation",
     "HeadCameraSpec",
+    "LEARNING_MODES",
+    "LearnThenHomeEnv",
     "OdometryNoise",
     "Quadruped",
     "Scene",

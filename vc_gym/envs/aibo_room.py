@@ -191,6 +191,11 @@ class AiboRoomEnv(gym.Env):
             raise RuntimeError("call reset() first")
         return self._scene
 
+    @property
+    def scene_key(self) -> tuple | None:
+        """``(scene, randomize, scene seed)`` of the built scene: changes when it is rebuilt."""
+        return self._scene_key
+
     def _check_open(self) -> None:
         if self._closed:
             raise RuntimeError("this AiboRoomEnv is closed; make a new one")

@@ -69,7 +69,7 @@ def run_demo(
             "success": bool(record.stopped and result["home_error_m"] <= success_radius_m),
             "success_radius_m": success_radius_m,
             "start_pose": list(record.start) if record.start else None,
-            "odometry_turn_calibration": agent.rot_scale,
+            "odometry_turn_calibration": agent.learner.rot_scale,
         }
         _plot(out / "demo.png", record, TopView(env.unwrapped.client, env.unwrapped.scene))
     finally:

@@ -1,0 +1,135 @@
+"""CompassObservation: compass, atlas and filters inside the env; never the true pose."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium import spaces
+
+from vc_gym.angles import wrap180
+from vc_gym.compass import Camera
+from vc_gym.compass.synthetic_room import render_room_view
+from vc_gym.envs.compass_observation import CompassObservation
+
+
+class RayCastRobot(gym.Env):
+    """A robot in the ray-cast room: turns and walks by its actions, sees the room.
+
+    ``leak`` decides what ``info["pose"]`` holds: the truth, or garbage. A wrapper that
+    never looks at the true pose gives the same observations either way.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, room, start=(0.6, -0.4, 30.0), leak="truth"):
+        self.room, self.start, self.leak = room, start, leak
+        self.control_dt = 0.1
+        self.camera = SimpleNamespace(hfov_deg=Camera().hfov_deg)
+        self.observation_space = spaces.Dict(
+            {
+                "image": spaces.Box(0, 255, (160, 208, 3), np.uint8),
+                "head": spaces.Box(-90.0, 90.0, (2,), np.float32),
+                "odometry": spaces.Box(-720.0, 720.0, (3,), np.float32),
+            }
+        )
+        self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)  # forward m, turn /45 deg
+
+    def _obs(self, odo):
+        x, y, yaw = self.pose
+        img = render_room_view(self.room, x, y, Camera(yaw_deg=yaw))
+        return {
+            "image": img,
+            "head": np.zeros(2, np.float32),
+            "odometry": np.asarray(odo, np.float32),
+        }
+
+    def _info(self):
+        if self.leak == "truth":
+            return {"pose": np.array(self.pose)}
+        return {"pose": self.np_random.uniform(-9, 9, 3)}
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.pose = list(self.start)
+        return self._obs((0.0, 0.0, 0.0)), self._info()
+
+    def step(self, action):
+        fwd, turn = 0.1 * float(action[0]), 45.0 * float(action[1])
+        x, y, yaw = self.pose
+        th = math.radians(yaw)
+        self.pose = [x + fwd * math.cos(th), y + fwd * math.sin(th), (yaw + turn) % 360.0]
+        return self._obs((fwd, 0.0, turn)), 0.0, False, False, self._info()
+
+
+ACTIONS = [(0.0, 0.0)] * 6 + [(0.0, 0.5)] * 4 + [(1.0, 0.0)] * 4 + [(0.0, -0.3)] * 4
+
+
+def run(env, actions=ACTIONS):
+    obs, _ = env.reset(seed=0)
+    out = [obs]
+    for a in actions:
+        obs, *_ = env.step(np.array(a, np.float32))
+        out.append(obs)
+    return out
+
+
+def test_observation_never_depends_on_the_true_pose(synthetic_room, room_atlas):
+    honest = run(CompassObservation(RayCastRobot(synthetic_room, leak="truth"), room_atlas))
+    liar = run(CompassObservation(RayCastRobot(synthetic_room, leak="garbage"), room_atlas))
+    for a, b in zip(honest, liar, strict=True):
+        assert a.keys() == b.keys()
+        for k in a:
+            np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+    assert "pose" not in honest[0]
+
+
+def test_estimates_track_the_robot(synthetic_room, room_atlas):
+    env = RayCastRobot(synthetic_room)
+    w = CompassObservation(env, room_atlas, belief_bins=36)
+    obs_seq = run(w)
+    obs = obs_seq[-1]
+    true_x, true_y, true_yaw = env.pose
+    heading = math.degrees(math.atan2(obs["heading"][1], obs["heading"][0]))
+    assert abs(wrap180(heading - true_yaw)) < 10.0
+    assert obs["heading_spread"][0] < 30.0
+    # the atlas position is coarse (paper: ~0.3 m); it lies towards the robot, not at home
+    pos = obs["position"]
+    assert np.hypot(pos[0] - true_x, pos[1] - true_y) < np.hypot(true_x, true_y)
+    # home_vector is home in the robot's estimated frame
+    th = math.atan2(obs["heading"][1], obs["heading"][0])
+    hx, hy = -pos[0], -pos[1]
+    expect = (hx * math.cos(th) + hy * math.sin(th), -hx * math.sin(th) + hy * math.cos(th))
+    np.testing.assert_allclose(obs["home_vector"], expect, atol=1e-4)
+    assert obs["goodness"].shape == (4,) and np.all(obs["goodness"] > 0)
+    assert obs["belief"].shape == (36,) and obs["belief"].sum() == pytest.approx(1.0, abs=1e-5)
+    assert abs(wrap180(10.0 * int(np.argmax(obs["belief"])) + 5.0 - true_yaw)) <= 15.0
+    assert w.observation_space.contains(obs)
+
+
+def test_keep_image_and_padding(synthetic_room, room_atlas):
+    w = CompassObservation(RayCastRobot(synthetic_room), room_atlas, n_spots=6, keep_image=False)
+    obs, _ = w.reset(seed=0)
+    assert "image" not in obs and "image" not in w.observation_space.spaces
+    assert obs["goodness"].shape == (6,) and np.all(obs["goodness"][4:] == 0)
+    assert w.observation_space.contains(obs)
+
+
+def test_bad_arguments(synthetic_room, room_atlas):
+    env = RayCastRobot(synthetic_room)
+    with pytest.raises(ValueError, match="pass an atlas"):
+        CompassObservation(env)
+    with pytest.raises(ValueError, match="CompassAtlas"):
+        CompassObservation(env, atlas="atlas.npz")
+    with pytest.raises(ValueError, match="belief_bins"):
+        CompassObservation(env, room_atlas, belief_bins=7)
+    with pytest.raises(ValueError, match="half_life_s"):
+        CompassObservation(env, room_atlas, half_life_s=float("nan"))
+    with pytest.raises(ValueError, match="4 spots"):
+        CompassObservation(env, room_atlas, n_spots=2).reset(seed=0)
+    plain = gym.make("CartPole-v1")
+    with pytest.raises(ValueError, match="image"):
+        CompassObservation(plain, room_atlas)

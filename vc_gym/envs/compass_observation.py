@@ -1,0 +1,194 @@
+"""A wrapper that puts the visual compass, its atlas and the filters inside the env."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.compass.tracker import AtlasTracker
+
+__all__ = ["CompassObservation"]
+
+_BIG = np.float32(1e6)
+
+
+class CompassObservation(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Adds what the robot's compass and filters know to each observation.
+
+    Every step, the wrapped env's head-camera frame, head pan and odometry go through
+    an :class:`~vc_gym.compass.tracker.AtlasTracker` (the paper's orientational grid
+    filter, eq. 23-27, and translational filter, eq. 30-32, fed by the atlas of
+    compasses learned at the training spots). Agents, including learned ones, then
+    work from the compass, never from the true pose: nothing in the observation
+    depends on ``info`` (tested).
+
+    Observation keys added to the wrapped env's ``Dict`` (world frame of the atlas,
+    home at the atlas' home position):
+
+    * ``heading``: ``(cos θ̂, sin θ̂)`` of the estimated body heading (eq. 25);
+    * ``heading_spread``: circular standard deviation of the heading belief, degrees
+      (eq. 26-27);
+    * ``position``: filtered position estimate ``τ̂`` in metres (eq. 32);
+    * ``home_vector``: home as seen from the estimated pose, in the robot's frame
+      (forward, left) in metres;
+    * ``goodness``: normalised goodness ``L̂_i`` of each spot (eq. 28), padded with
+      zeros to ``n_spots`` (capped at 10⁶);
+    * ``belief`` (when ``belief_bins > 0``): the heading belief summed into
+      ``belief_bins`` equal sectors starting at 0°.
+
+    Where the env has no atlas yet (the learning phase of
+    ``vc_gym/LearnThenHome-v0`` with ``learning="agent"``) the added keys are zeros,
+    the heading spread is 180° and the belief uniform.
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        An env whose observations hold ``image``, ``head`` and ``odometry`` like
+        ``vc_gym/AiboRoom-v0`` (its ``unwrapped`` must have ``control_dt`` and a
+        ``camera`` with ``hfov_deg``).
+    atlas : CompassAtlas, optional
+        The learned atlas. Default: ``env.unwrapped.atlas``, read again at every
+        reset (``vc_gym/LearnThenHome-v0`` learns it during reset).
+    n_spots : int, optional
+        Length of ``goodness``. Default: the atlas' spot count, or
+        ``env.unwrapped.max_spots``.
+    keep_image : bool
+        Keep the camera frame in the observation. Learned agents usually drop it and
+        work from the compass outputs alone (a small MLP policy, fast training).
+    belief_bins : int
+        Number of sectors of the downsampled heading belief (0: no ``belief`` key).
+        Must divide 360.
+    half_life_s : float
+        Half-life of both filters (paper 4.2: 0.3 s).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        atlas: CompassAtlas | None = None,
+        n_spots: int | None = None,
+        keep_image: bool = True,
+        belief_bins: int = 0,
+        half_life_s: float = 0.3,
+    ):
+        gym.utils.RecordConstructorArgs.__init__(
+            self,
+            atlas=atlas,
+            n_spots=n_spots,
+            keep_image=keep_image,
+            belief_bins=belief_bins,
+            half_life_s=half_life_s,
+        )
+        gym.Wrapper.__init__(self, env)
+        inner = env.observation_space
+        if not isinstance(inner, spaces.Dict) or not {"image", "head", "odometry"} <= set(
+            inner.spaces
+        ):
+            raise ValueError(
+                "CompassObservation needs a Dict observation with 'image', 'head' and "
+                f"'odometry' (like vc_gym/AiboRoom-v0), got {inner}"
+            )
+        if atlas is not None and not isinstance(atlas, CompassAtlas):
+            raise ValueError(f"atlas must be a CompassAtlas, got {type(atlas).__name__}")
+        if atlas is None and not hasattr(env.unwrapped, "atlas"):
+            raise ValueError(
+                "pass an atlas: the wrapped env does not learn one (only "
+                "vc_gym/LearnThenHome-v0 does)"
+            )
+        if n_spots is None:
+            n_spots = len(atlas) if atlas is not None else getattr(env.unwrapped, "max_spots", 0)
+        if int(n_spots) < 1:
+            raise ValueError(f"n_spots must be >= 1, got {n_spots!r}")
+        belief_bins = int(belief_bins)
+        if belief_bins < 0 or (belief_bins and 360 % belief_bins):
+            raise ValueError(f"belief_bins must be 0 or divide 360, got {belief_bins}")
+        if not (math.isfinite(half_life_s) and half_life_s > 0):
+            raise ValueError(f"half_life_s must be finite and > 0, got {half_life_s!r}")
+        self.fixed_atlas = atlas
+        self.n_spots = int(n_spots)
+        self.keep_image = bool(keep_image)
+        self.belief_bins = belief_bins
+        self.half_life_s = float(half_life_s)
+        self.camera = Camera(hfov_deg=env.unwrapped.camera.hfov_deg)
+        self.tracker: AtlasTracker | None = None
+
+        keys = dict(inner.spaces)
+        if not self.keep_image:
+            del keys["image"]
+        keys["heading"] = spaces.Box(-1.0, 1.0, (2,), np.float32)
+        keys["heading_spread"] = spaces.Box(0.0, 180.0, (1,), np.float32)
+        keys["position"] = spaces.Box(-100.0, 100.0, (2,), np.float32)
+        keys["home_vector"] = spaces.Box(-200.0, 200.0, (2,), np.float32)
+        keys["goodness"] = spaces.Box(0.0, _BIG, (self.n_spots,), np.float32)
+        if self.belief_bins:
+            keys["belief"] = spaces.Box(0.0, 1.0, (self.belief_bins,), np.float32)
+        self.observation_space = spaces.Dict(keys)
+
+    @property
+    def atlas(self) -> CompassAtlas | None:
+        """The atlas in use (``None`` before the env has learned one)."""
+        if self.fixed_atlas is not None:
+            return self.fixed_atlas
+        return getattr(self.env.unwrapped, "atlas", None)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        obs, info = self.env.reset(seed=seed, options=options)
+        self.tracker = None
+        self._attach()
+        return self._augment(obs), info
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if self.tracker is None:
+            self._attach()  # the atlas may have been learned during this step
+        return self._augment(obs), reward, terminated, truncated, info
+
+    def _attach(self) -> None:
+        atlas = self.atlas
+        if atlas is None:
+            return
+        if len(atlas) > self.n_spots:
+            raise ValueError(
+                f"the atlas has {len(atlas)} spots but the observation holds {self.n_spots}"
+            )
+        self.tracker = AtlasTracker(
+            atlas, self.camera, dt_s=self.env.unwrapped.control_dt, half_life_s=self.half_life_s
+        )
+
+    def _augment(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        out = {k: v for k, v in obs.items() if self.keep_image or k != "image"}
+        goodness = np.zeros(self.n_spots, np.float32)
+        if self.tracker is None:
+            heading = np.zeros(2, np.float32)
+            spread, position, home_vec = 180.0, np.zeros(2), np.zeros(2)
+            belief = np.full(360, 1.0 / 360.0)
+        else:
+            state = self.tracker.update(
+                obs["image"], float(obs["head"][0]), np.asarray(obs["odometry"], np.float64)
+            )
+            th = math.radians(state.heading_deg)
+            heading = np.array([math.cos(th), math.sin(th)], np.float32)
+            spread = state.heading_spread_deg
+            position = np.asarray(state.position)
+            hx, hy = np.asarray(self.tracker.atlas.home_position) - position
+            home_vec = np.array(
+                [hx * math.cos(th) + hy * math.sin(th), -hx * math.sin(th) + hy * math.cos(th)]
+            )
+            g = np.minimum(state.goodness, _BIG)
+            goodness[: g.size] = g
+            belief = state.belief
+        out["heading"] = heading
+        out["heading_spread"] = np.array([min(spread, 180.0)], np.float32)
+        out["position"] = np.clip(position, -100.0, 100.0).astype(np.float32)
+        out["home_vector"] = np.clip(home_vec, -200.0, 200.0).astype(np.float32)
+        out["goodness"] = goodness
+        if self.belief_bins:
+            out["belief"] = belief.reshape(self.belief_bins, -1).sum(axis=1).astype(np.float32)
+        return out

@@ -1,0 +1,394 @@
+"""The paper's task: learn a place, be kidnapped, walk back home (sections 4.3, 5.2)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from vc_gym.angles import wrap360
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
+from vc_gym.envs.aibo_room import AiboRoomEnv
+
+__all__ = ["LearnThenHomeEnv", "LEARNING_MODES"]
+
+LEARNING_MODES = ("scripted", "agent")
+RELEARN_MODES = ("scene", "episode")
+HOME = (0.0, 0.0)
+
+
+@dataclass
+class _Frame:
+    image: np.ndarray
+    x: float
+    y: float
+    camera_yaw_deg: float
+
+
+class LearnThenHomeEnv(gym.Env):
+    """Learn the panorama around home, get kidnapped, walk back home.
+
+    ## Description
+
+    The homing experiment of Sturm & Visser (5.2) on ``vc_gym/AiboRoom-v0``. Home is the
+    world origin (robolab: the centre of the kickoff circle); the robot starts there
+    facing 0°. In the **learning phase** it learns the panorama at spots around home:
+    either by the scripted behaviour of the paper (``learning="scripted"``: a full turn
+    at home, four spots 1 m away, 8 × 45° each for ``learn_time_s``, normalisation at
+    home; run inside :meth:`reset`) or by the agent itself (``learning="agent"``: the
+    agent walks and marks frames to learn, see the action space). Then it is
+    **kidnapped** to a random pose on the field (``kidnap_margin_m`` inside its edges)
+    with a random heading, and **homes**. The learned :class:`CompassAtlas` is the
+    ``atlas`` attribute; wrap the env in :class:`~vc_gym.envs.CompassObservation` to
+    give the agent the compass' and filters' estimates.
+
+    ## Action Space
+
+    ``Box(-1, 1, (5,), float32)`` as in ``vc_gym/AiboRoom-v0`` (forward, sideways,
+    turn, head pan, head tilt). With ``learning="agent"`` it is ``Box(-1, 1, (7,))``:
+    the two extra entries are *learn* (> 0: learn this frame at the spot the robot
+    believes it is at) and *finish* (> 0: end the learning phase); both are ignored
+    while homing.
+
+    ## Observation Space
+
+    ``Dict`` of ``vc_gym/AiboRoom-v0`` (``image``, ``head``, ``odometry``) plus
+    ``phase``: ``Box(0, 1, (1,))``, 0 while learning, 1 while homing. Never the true pose.
+
+    ## Rewards
+
+    While homing, each step earns ``progress_reward × (d_before − d_after)``, where
+    ``d`` is the true distance from home in metres (walking 1 m closer earns
+    ``progress_reward``, 10 by default). Stopping (standing still for ``stop_time_s``)
+    within ``success_radius_m`` of home adds ``success_bonus`` (10); falling costs
+    ``fall_penalty`` (10). The learning phase earns nothing; an agent that learned no
+    frame ends the episode with ``-fall_penalty``.
+
+    ## Starting State
+
+    The returned observation is the first homing frame (scripted learning) or the
+    robot at home facing 0° (agent learning). ``options={"pose": (x, y, yaw)}`` sets
+    the kidnapping pose.
+
+    ## Episode End
+
+    Terminated when the robot has stood still (``|forward|``, ``|sideways|`` and
+    ``|turn|`` actions all ≤ ``still_threshold``; the head may move) for ``stop_time_s``
+    while homing (paper: 5 s), or falls; truncated after ``max_homing_s`` of homing or
+    ``max_learning_s`` of agent learning without finishing.
+
+    ## Arguments
+
+    ``gym.make("vc_gym/LearnThenHome-v0", learning="scripted", relearn="scene",
+    learn_time_s=5.0, spot_distance_m=1.0, stop_time_s=5.0, success_radius_m=0.3,
+    max_homing_s=60.0, ...)`` — see ``__init__``; other keyword arguments (``scene``,
+    ``randomize``, ``locomotion``, ``illumination``, ``control_dt``,
+    ``odometry_noise``, ``camera``, ...) go to ``vc_gym/AiboRoom-v0``.
+    ``relearn="scene"`` learns once per scene and reuses the atlas in later episodes
+    (the paper learned once and kidnapped many times); ``"episode"`` learns anew in
+    every reset.
+
+    ## Info
+
+    Everything ``vc_gym/AiboRoom-v0`` reports (``pose`` is the true pose: for
+    evaluation, not for agents), ``phase`` (``"learning"``/``"homing"``),
+    ``home_error_m`` (true distance from home), ``still_time_s``; at the end of an
+    episode also ``stop_position`` (true x, y), ``stop_error_m``, ``stopped``,
+    ``success`` and ``is_success`` (stopped within ``success_radius_m``).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        learning: str = "scripted",
+        relearn: str = "scene",
+        learn_time_s: float = 5.0,
+        spot_distance_m: float = 1.0,
+        stop_time_s: float = 5.0,
+        success_radius_m: float = 0.3,
+        max_homing_s: float = 60.0,
+        max_learning_s: float = 300.0,
+        kidnap_margin_m: float = 0.5,
+        still_threshold: float = 0.05,
+        progress_reward: float = 10.0,
+        success_bonus: float = 10.0,
+        fall_penalty: float = 10.0,
+        max_spots: int = 8,
+        spot_radius_m: float = 0.25,
+        compass: CompassConfig | None = None,
+        **room_kwargs: Any,
+    ):
+        if learning not in LEARNING_MODES:
+            raise ValueError(f"learning must be one of {LEARNING_MODES}, got {learning!r}")
+        if relearn not in RELEARN_MODES:
+            raise ValueError(f"relearn must be one of {RELEARN_MODES}, got {relearn!r}")
+        for name, v in (
+            ("learn_time_s", learn_time_s),
+            ("spot_distance_m", spot_distance_m),
+            ("stop_time_s", stop_time_s),
+            ("success_radius_m", success_radius_m),
+            ("max_homing_s", max_homing_s),
+            ("max_learning_s", max_learning_s),
+            ("spot_radius_m", spot_radius_m),
+        ):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        for name, v in (
+            ("kidnap_margin_m", kidnap_margin_m),
+            ("still_threshold", still_threshold),
+            ("progress_reward", progress_reward),
+            ("success_bonus", success_bonus),
+            ("fall_penalty", fall_penalty),
+        ):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
+        if still_threshold >= 1:
+            raise ValueError(f"still_threshold must be < 1, got {still_threshold}")
+        if not (isinstance(max_spots, int) and max_spots >= 1):
+            raise ValueError(f"max_spots must be an int >= 1, got {max_spots!r}")
+        if compass is not None and not isinstance(compass, CompassConfig):
+            raise ValueError(f"compass must be a CompassConfig, got {type(compass).__name__}")
+        from vc_gym.agents.scripted import LearnThenHomeConfig  # the task's learning behaviour
+
+        self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
+        self.render_mode = render_mode
+        self.learning = learning
+        self.relearn = relearn
+        self.learn_config = LearnThenHomeConfig(
+            spot_distance_m=float(spot_distance_m),
+            learn_time_s=float(learn_time_s),
+            stop_time_s=float(stop_time_s),
+            max_homing_s=float(max_homing_s),
+            compass=compass if compass is not None else CompassConfig(),
+        )
+        self.stop_time_s = float(stop_time_s)
+        self.success_radius_m = float(success_radius_m)
+        self.max_homing_s = float(max_homing_s)
+        self.max_learning_s = float(max_learning_s)
+        self.kidnap_margin_m = float(kidnap_margin_m)
+        self.still_threshold = float(still_threshold)
+        self.progress_reward = float(progress_reward)
+        self.success_bonus = float(success_bonus)
+        self.fall_penalty = float(fall_penalty)
+        self.max_spots = 4 if learning == "scripted" else int(max_spots)
+        self.spot_radius_m = float(spot_radius_m)
+        self.control_dt = self.room.control_dt
+        self.camera = self.room.camera
+
+        n_act = 5 if learning == "scripted" else 7
+        self.action_space = spaces.Box(-1.0, 1.0, (n_act,), np.float32)
+        self.observation_space = spaces.Dict(
+            {**self.room.observation_space.spaces, "phase": spaces.Box(0.0, 1.0, (1,), np.float32)}
+        )
+
+        self.atlas: CompassAtlas | None = None
+        self._atlas_key: tuple | None = None
+        self._phase: str | None = None
+        self._frames: list[_Frame] = []
+        self._belief = np.zeros(3)  # dead-reckoned pose while the agent learns
+        self._phase_time = 0.0
+        self._still_steps = 0
+        self._distance = 0.0
+        self._pending_options: dict[str, Any] = {}
+
+    # ------------------------------------------------------------------ helpers
+    @property
+    def phase(self) -> str | None:
+        """``"learning"``, ``"homing"`` or ``None`` before the first reset / after the end."""
+        return self._phase
+
+    def _home_distance(self, info: dict[str, Any]) -> float:
+        x, y = info["pose"][:2]
+        return math.hypot(x - HOME[0], y - HOME[1])
+
+    def _obs(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        phase = 1.0 if self._phase == "homing" else 0.0
+        return {**obs, "phase": np.array([phase], np.float32)}
+
+    def _info(self, info: dict[str, Any]) -> dict[str, Any]:
+        return {
+            **info,
+            "phase": self._phase,
+            "home_error_m": self._home_distance(info),
+            "still_time_s": self._still_steps * self.control_dt,
+        }
+
+    def _kidnap(self, options: dict[str, Any], seed: int | None = None) -> tuple[dict, dict]:
+        from vc_gym.agents.scripted import kidnap_pose
+
+        if "pose" in options:
+            pose = options["pose"]
+        else:
+            pose = kidnap_pose(self.np_random, self.room.scene.field_bounds, self.kidnap_margin_m)
+        obs, info = self.room.reset(seed=seed, options={"pose": pose})
+        self._phase = "homing"
+        self._phase_time = 0.0
+        self._still_steps = 0
+        self._distance = self._home_distance(info)
+        return obs, info
+
+    # ------------------------------------------------------------------ gym API
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = set(options) - {"pose"}
+        if unknown:
+            raise ValueError(f"unknown reset options {sorted(unknown)}; known: ['pose']")
+        room_seed = int(self.np_random.integers(2**31))
+        self._still_steps = 0
+        self._phase_time = 0.0
+        if (
+            self.learning == "scripted"
+            and self.atlas is not None
+            and self.relearn == "scene"
+            and not self.room.randomize  # a randomised scene may change with the seed
+        ):  # the place is known: straight to the kidnapping
+            obs, info = self._kidnap(options, seed=room_seed)
+            return self._obs(obs), self._info(info)
+        obs, info = self.room.reset(seed=room_seed, options={"pose": (*HOME, 0.0)})
+        if self.learning == "agent":
+            self.atlas = None
+            self._frames = []
+            self._belief = np.zeros(3)
+            self._phase = "learning"
+            self._pending_options = options
+            return self._obs(obs), self._info(info)
+        key = self.room.scene_key
+        if self.atlas is None or self.relearn == "episode" or key != self._atlas_key:
+            from vc_gym.agents.scripted import RobotFell, ScriptedLearner
+
+            learner = ScriptedLearner(self.room, self.learn_config, progress=False)
+            learner.obs, learner.info = obs, info
+            self.atlas = None
+            try:
+                self.atlas = learner.learn()
+            except RobotFell as exc:
+                raise RuntimeError(
+                    "the robot fell during the scripted learning phase; use "
+                    "locomotion='constraint' (the default) for this task"
+                ) from exc
+            self._atlas_key = key
+        obs, info = self._kidnap(options)
+        return self._obs(obs), self._info(info)
+
+    def step(
+        self, action: np.ndarray
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        if self._phase is None:
+            self.room._check_open()
+            raise RuntimeError("call reset() before step() (the episode has ended or not begun)")
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != self.action_space.shape:
+            raise ValueError(f"action must have shape {self.action_space.shape}, got {a.shape}")
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"action must be finite, got {action!r}")
+        a = np.clip(a, -1.0, 1.0)
+        if self._phase == "learning":
+            return self._learning_step(a)
+        obs, _, fell, _, info = self.room.step(a[:5])
+        self._phase_time += self.control_dt
+        d = self._home_distance(info)
+        reward = self.progress_reward * (self._distance - d)
+        self._distance = d
+        still = bool(np.all(np.abs(a[:3]) <= self.still_threshold))
+        self._still_steps = self._still_steps + 1 if still else 0
+        stopped = self._still_steps * self.control_dt >= self.stop_time_s - 1e-9
+        terminated = fell or stopped
+        truncated = not terminated and self._phase_time >= self.max_homing_s - 1e-9
+        info = self._info(info)
+        if fell:
+            reward -= self.fall_penalty
+        if terminated or truncated:
+            success = stopped and not fell and d <= self.success_radius_m
+            if success:
+                reward += self.success_bonus
+            info.update(
+                stop_position=np.asarray(info["pose"][:2], np.float64),
+                stop_error_m=d,
+                stopped=stopped and not fell,
+                success=success,
+                is_success=success,
+            )
+            self._phase = None
+        return self._obs(obs), float(reward), terminated, truncated, info
+
+    def _learning_step(self, a: np.ndarray):
+        obs, _, fell, _, info = self.room.step(a[:5])
+        self._phase_time += self.control_dt
+        fwd, left, turn = (float(v) for v in obs["odometry"])
+        th = math.radians(self._belief[2])
+        self._belief += [
+            fwd * math.cos(th) - left * math.sin(th),
+            fwd * math.sin(th) + left * math.cos(th),
+            turn,
+        ]
+        self._belief[2] = wrap360(self._belief[2])
+        if a[5] > 0:
+            pan = float(obs["head"][0])
+            self._frames.append(
+                _Frame(obs["image"], self._belief[0], self._belief[1], self._belief[2] + pan)
+            )
+        if fell:
+            self._phase = None
+            info = self._info(info)
+            info.update(stopped=False, success=False, is_success=False)
+            return self._obs(obs), -self.fall_penalty, True, False, info
+        if a[6] > 0 or self._phase_time >= self.max_learning_s - 1e-9:
+            self.atlas = self._atlas_from_frames()
+            if self.atlas is None:
+                self._phase = None
+                info = self._info(info)
+                info.update(stopped=False, success=False, is_success=False, learned=False)
+                return self._obs(obs), -self.fall_penalty, True, False, info
+            obs, info = self._kidnap(self._pending_options)
+        return self._obs(obs), 0.0, False, False, self._info(info)
+
+    def _atlas_from_frames(self) -> CompassAtlas | None:
+        """Spots from the frames the agent marked: frames closer than ``spot_radius_m``
+        (by odometry) to a spot's first frame join it; at most ``max_spots`` spots."""
+        frames = self._frames
+        if not frames:
+            return None
+        cfg = self.learn_config.compass
+        pick = np.linspace(0, len(frames) - 1, min(len(frames), 24)).round().astype(int)
+        colors = VisualCompass(cfg).fit_colors([frames[i].image for i in pick]).colors
+        anchors: list[tuple[float, float]] = []
+        members: list[list[_Frame]] = []
+        for f in frames:
+            d = [math.hypot(f.x - ax, f.y - ay) for ax, ay in anchors]
+            if d and (min(d) <= self.spot_radius_m or len(anchors) >= self.max_spots):
+                members[int(np.argmin(d))].append(f)
+            else:
+                anchors.append((f.x, f.y))
+                members.append([f])
+        camera = Camera(hfov_deg=self.camera.hfov_deg)
+        spots = {}
+        for i, group in enumerate(members):
+            vc = VisualCompass(cfg, colors)
+            for f in group:
+                vc.learn(f.image, camera.replace(yaw_deg=f.camera_yaw_deg))
+            xy = (float(np.mean([f.x for f in group])), float(np.mean([f.y for f in group])))
+            spots[f"spot{i}"] = (xy, vc)
+        atlas = CompassAtlas(spots, home="home", home_position=HOME)
+        at_home = [f for f in frames if math.hypot(f.x, f.y) <= self.spot_radius_m]
+        if not at_home:  # normalise with the frames of the spot closest to home
+            nearest = int(np.argmin([math.hypot(*xy) for xy, _ in spots.values()]))
+            at_home = members[nearest]
+        atlas.normalize([f.image for f in at_home], camera)
+        return atlas
+
+    def render(self) -> np.ndarray | None:
+        """The room's ``rgb_array`` view: top view with the robot and its camera frame."""
+        return self.room.render()
+
+    def close(self) -> None:
+        self.room.close()
+        self._phase = None
