@@ -104,7 +104,8 @@ def test_stop_action_holds_still_until_the_task_stops():
     assert info["still_time_s"] == pytest.approx(1.0)
     env.reset(seed=0, options={"pose": (1.0, 0.0, 180.0)})
     _, r, terminated, _, info = env.step(np.array([1.0, 0.0, -1.0], np.float32))
-    assert not terminated and r == pytest.approx(0.4, abs=1e-3)  # 4 cm closer (0.4 m/s), x10
+    assert not terminated and r > 0.2  # walked towards home (0.4 m/s for 0.1 s, from rest)
+    assert r == pytest.approx(10.0 * (1.0 - info["home_error_m"]), abs=1e-6)
     with pytest.raises(ValueError):
         env.step(np.array([np.nan, 0.0, 0.0]))
     env.close()
@@ -147,3 +148,14 @@ def test_bad_model_files_are_clear_errors(tmp_path, capsys):
     assert main(["evaluate", "--agent", str(tmp_path / "model.zip"), "--episodes", "1"]) == 2
     assert "cannot load" in capsys.readouterr().err
     assert main(["evaluate", "--agent", "nowhere/model.zip", "--episodes", "1"]) == 2
+
+
+def test_shipped_policy_loads_and_walks_towards_home_ahead():
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+
+    agent = LearnedHomingAgent(PRETRAINED_MODEL)
+    assert agent.config.algo == "ppo" and agent.config.scene == "robolab"
+    # home 1.5 m straight ahead, heading known (spread 9 deg), goodness as at home
+    features = np.array([0.75, 0.0, 1.0, 0.0, 0.05, -0.75, 0.0, 0, 0, 0, 0, 0.0], np.float32)
+    forward, _, stop = agent.predict(features)
+    assert forward > 0.5 and stop <= 0.5

@@ -237,6 +237,7 @@ class LearnThenHomeEnv(gym.Env):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        self.room._check_open()
         super().reset(seed=seed)
         options = dict(options or {})
         unknown = set(options) - {"pose"}

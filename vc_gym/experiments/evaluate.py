@@ -224,8 +224,10 @@ def _plot(path: Path, offsets_cm: np.ndarray, summary: dict) -> None:
     circle = plt.Circle((0, 0), summary["success_radius_m"] * 100, fill=False, ls="--", color="0.5")
     ax.add_patch(circle)
     ax.set_aspect("equal")
-    ax.set_xlim(-150, 150)
-    ax.set_ylim(-150, 150)
+    # the paper's figure spans ±1.5 m; widen it so that no stop falls off the plot
+    lim = max(150.0, float(np.abs(offsets_cm).max()) + 20.0)
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
     ax.set_xlabel("x offset from home (cm)")
     ax.set_ylabel("y offset from home (cm)")
     name = "scripted" if summary["agent"] == "scripted" else Path(summary["agent"]).parent.name
