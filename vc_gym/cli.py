@@ -37,6 +37,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         seed=args.seed,
         learn_time_s=args.learn_time,
         relearn=args.relearn,
+        max_homing_s=args.max_homing,
         workers=args.workers,
         out_dir=args.out,
         progress=not args.json,
@@ -268,6 +269,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=int, default=33)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--learn-time", type=float, default=5.0, help="seconds per direction")
+    p.add_argument(
+        "--max-homing",
+        type=float,
+        default=60.0,
+        metavar="S",
+        help="homing seconds before an episode ends as timed out",
+    )
     p.add_argument("--workers", type=int, default=2, help="parallel processes")
     p.add_argument("--out", metavar="DIR", help="folder for evaluation.json and the plot")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")

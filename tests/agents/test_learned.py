@@ -60,6 +60,7 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
         episodes=2,
         seed=1,
         learn_time_s=0.2,
+        max_homing_s=5.0,
         workers=1,
         out_dir=tmp_path,
         progress=False,
@@ -67,6 +68,7 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
     assert len(r["per_episode"]) == 2 and r["agent"].endswith("model.zip")
     for ep in r["per_episode"]:
         assert ep["stopped"] or ep["timed_out"] or ep["fell"]
+        assert ep["sim_time_s"] <= 5.0 + 1e-6
     assert (tmp_path / "stop_positions.png").read_bytes()[:4] == b"\x89PNG"
     code = main(
         [
@@ -79,6 +81,8 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
             "1",
             "--learn-time",
             "0.2",
+            "--max-homing",
+            "5",
             "--json",
         ]
     )

@@ -12,13 +12,20 @@ from vc_gym.experiments.evaluate import evaluate_agent
 
 def test_evaluate_scripted_summarises_stops(tmp_path):
     r = evaluate_agent(
-        episodes=2, seed=3, learn_time_s=0.2, workers=2, out_dir=tmp_path, progress=False
+        episodes=2,
+        seed=3,
+        learn_time_s=0.2,
+        max_homing_s=20.0,
+        workers=2,
+        out_dir=tmp_path,
+        progress=False,
     )
     assert [e["seed"] for e in r["per_episode"]] == [4, 5]
     assert len(r["mean_stop_offset_cm"]) == 2 and len(r["std_stop_offset_cm"]) == 2
     assert 0.0 <= r["success_rate"] <= 1.0
     for ep in r["per_episode"]:
         assert ep["stopped"] or ep["timed_out"]
+        assert ep["sim_time_s"] <= 20.0 + 1e-6
         assert ep["home_error_m"] == pytest.approx(
             (ep["stop_offset_m"][0] ** 2 + ep["stop_offset_m"][1] ** 2) ** 0.5
         )
@@ -38,3 +45,5 @@ def test_evaluate_rejects_bad_numbers():
         evaluate_agent(episodes=0)
     with pytest.raises(ValueError):
         evaluate_agent(relearn="sometimes")
+    with pytest.raises(ValueError):
+        evaluate_agent(max_homing_s=float("nan"))

@@ -31,7 +31,9 @@ PAPER_STD_CM = (17.0, 15.0)
 _WORKER: dict = {}
 
 
-def _make(agent: str, learn_time_s: float, success_radius_m: float, relearn: str):
+def _make(
+    agent: str, learn_time_s: float, success_radius_m: float, relearn: str, max_homing_s: float
+):
     """The evaluation env and a policy ``obs -> action`` (with an optional ``reset``)."""
     import gymnasium as gym
 
@@ -45,7 +47,7 @@ def _make(agent: str, learn_time_s: float, success_radius_m: float, relearn: str
         "learn_time_s": learn_time_s,
         "stop_time_s": 5.0,  # the paper's rule, also for agents trained with a shorter one
         "success_radius_m": success_radius_m,
-        "max_homing_s": 60.0,
+        "max_homing_s": max_homing_s,
     }
     if agent == "scripted":
         env = gym.make("vc_gym/LearnThenHome-v0", **task)
@@ -60,8 +62,10 @@ def _make(agent: str, learn_time_s: float, success_radius_m: float, relearn: str
     return learned.make_env(**task), learned.predict, None
 
 
-def _init_worker(agent: str, seed: int, learn_time_s: float, radius: float, relearn: str) -> None:
-    env, act, reset = _make(agent, learn_time_s, radius, relearn)
+def _init_worker(
+    agent: str, seed: int, learn_time_s: float, radius: float, relearn: str, max_homing_s: float
+) -> None:
+    env, act, reset = _make(agent, learn_time_s, radius, relearn, max_homing_s)
     env.reset(seed=seed)  # the learning phase (every worker learns the same place)
     _WORKER.update(env=env, act=act, reset=reset)
 
@@ -102,6 +106,7 @@ def evaluate_agent(
     learn_time_s: float = 5.0,
     success_radius_m: float = 0.3,
     relearn: str = "scene",
+    max_homing_s: float = 60.0,
     workers: int = 2,
     out_dir: str | os.PathLike | None = None,
     progress: bool = True,
@@ -126,6 +131,9 @@ def evaluate_agent(
         ``"scene"``: learn once, then kidnap ``episodes`` times (the paper's protocol);
         ``"episode"``: learn anew before every kidnapping (odometry errors and maps
         differ per episode; much slower).
+    max_homing_s : float
+        Homing time after which an episode ends as timed out (stop position: where the
+        robot is then).
     workers : int
         Parallel processes (each learns the same place from the same seed).
     out_dir : path, optional
@@ -137,6 +145,8 @@ def evaluate_agent(
         raise ValueError("episodes and workers must be >= 1")
     if not (np.isfinite(success_radius_m) and success_radius_m > 0):
         raise ValueError(f"success_radius_m must be > 0, got {success_radius_m}")
+    if not (np.isfinite(max_homing_s) and max_homing_s > 0):
+        raise ValueError(f"max_homing_s must be > 0, got {max_homing_s}")
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
     if agent == "pretrained":
@@ -150,7 +160,7 @@ def evaluate_agent(
     from tqdm import tqdm
 
     t0 = time.perf_counter()
-    init = (agent, seed, learn_time_s, success_radius_m, relearn)
+    init = (agent, seed, learn_time_s, success_radius_m, relearn, max_homing_s)
     jobs = [seed + 1 + i for i in range(episodes)]
     workers = min(workers, episodes)
     if workers == 1:
@@ -182,6 +192,7 @@ def evaluate_agent(
         "episodes": episodes,
         "seed": seed,
         "learn_time_s": learn_time_s,
+        "max_homing_s": max_homing_s,
         "mean_stop_offset_cm": offsets.mean(axis=0).round(1).tolist(),
         "std_stop_offset_cm": offsets.std(axis=0, ddof=1).round(1).tolist()
         if episodes > 1
