@@ -19,7 +19,6 @@ processes (``SubprocVecEnv``) and writes ``model.zip``, ``config.json``,
 
 from __future__ import annotations
 
-import math
 import os
 import tempfile
 import time
@@ -32,6 +31,7 @@ import numpy as np
 from gymnasium import spaces
 
 from vc_gym.agents.scripted import LearnThenHomeConfig
+from vc_gym.validation import positive_float
 
 __all__ = [
     "ALGORITHMS",
@@ -132,8 +132,7 @@ class TrainConfig:
             "max_turn_deg_s",
         ):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+            positive_float(name, v)
         if not (0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
         if not self.net_arch or any(int(n) < 1 for n in self.net_arch):

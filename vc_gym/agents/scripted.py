@@ -23,6 +23,7 @@ from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.compass.sensors import interp_circular
 from vc_gym.filters import HeadingGridFilter
+from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = [
     "EpisodeRecord",
@@ -83,8 +84,7 @@ class LearnThenHomeConfig:
             "half_life_s",
         ):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+            positive_float(name, v)
         if not self.head_scan_deg or any(abs(p) > 90 for p in self.head_scan_deg):
             raise ValueError(
                 f"head_scan_deg must be non-empty pans within ±90°, got {self.head_scan_deg}"
@@ -361,10 +361,8 @@ class ScriptedHomingPolicy:
             ("max_spread_deg", max_spread_deg),
             ("rearm_factor", rearm_factor),
         ):
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
-        if not (math.isfinite(settle_time_s) and settle_time_s >= 0):
-            raise ValueError(f"settle_time_s must be finite and >= 0, got {settle_time_s!r}")
+            positive_float(name, v)
+        nonnegative_float("settle_time_s", settle_time_s)
         self.config = config if config is not None else LearnThenHomeConfig()
         self.dt_s = float(dt_s)
         self.max_forward = float(max_forward)

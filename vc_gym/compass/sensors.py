@@ -15,6 +15,7 @@ import numpy as np
 from vc_gym.compass.atlas import AtlasEstimate, CompassAtlas
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.visual_compass import VisualCompass
+from vc_gym.validation import positive_float
 
 __all__ = [
     "AtlasPoseSensor",
@@ -137,8 +138,7 @@ class AtlasPoseSensor:
             ("position_noise_m", position_noise_m),
             ("heading_temperature", heading_temperature),
         ):
-            if not math.isfinite(v) or v <= 0:
-                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+            positive_float(name, v)
         self.atlas = atlas
         self.camera = Camera() if camera is None else camera
         self.position_noise_m = float(position_noise_m)

@@ -20,6 +20,7 @@ from vc_gym.compass.atlas import CompassAtlas
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.sensors import best_spot_heading_log_likelihood
 from vc_gym.filters import HeadingGridFilter, TranslationalFilter
+from vc_gym.validation import nonnegative_float
 
 __all__ = ["AtlasTracker", "TrackerState"]
 
@@ -87,8 +88,7 @@ class AtlasTracker:
         if not isinstance(atlas, CompassAtlas):
             raise ValueError(f"atlas must be a CompassAtlas, got {type(atlas).__name__}")
         for name, v in (("motion_noise_deg", motion_noise_deg), ("turn_noise", turn_noise)):
-            if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
+            nonnegative_float(name, v)
         self.atlas = atlas
         self.camera = Camera() if camera is None else camera
         if not isinstance(self.camera, Camera):

@@ -11,6 +11,7 @@ from gymnasium import spaces
 
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.compass.tracker import AtlasTracker
+from vc_gym.validation import positive_float
 
 __all__ = ["CompassObservation"]
 
@@ -107,8 +108,7 @@ class CompassObservation(gym.Wrapper, gym.utils.RecordConstructorArgs):
         belief_bins = int(belief_bins)
         if belief_bins < 0 or (belief_bins and 360 % belief_bins):
             raise ValueError(f"belief_bins must be 0 or divide 360, got {belief_bins}")
-        if not (math.isfinite(half_life_s) and half_life_s > 0):
-            raise ValueError(f"half_life_s must be finite and > 0, got {half_life_s!r}")
+        positive_float("half_life_s", half_life_s)
         self.fixed_atlas = atlas
         self.n_spots = int(n_spots)
         self.keep_image = bool(keep_image)

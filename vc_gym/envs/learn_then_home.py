@@ -13,6 +13,7 @@ from gymnasium import spaces
 from vc_gym.angles import wrap360
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["LearnThenHomeEnv", "LEARNING_MODES"]
 
@@ -137,8 +138,7 @@ class LearnThenHomeEnv(gym.Env):
             ("max_learning_s", max_learning_s),
             ("spot_radius_m", spot_radius_m),
         ):
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+            positive_float(name, v)
         for name, v in (
             ("kidnap_margin_m", kidnap_margin_m),
             ("still_threshold", still_threshold),
@@ -146,8 +146,7 @@ class LearnThenHomeEnv(gym.Env):
             ("success_bonus", success_bonus),
             ("fall_penalty", fall_penalty),
         ):
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
+            nonnegative_float(name, v)
         if still_threshold >= 1:
             raise ValueError(f"still_threshold must be < 1, got {still_threshold}")
         if not (isinstance(max_spots, int) and max_spots >= 1):
