@@ -266,8 +266,13 @@ def build_parser() -> argparse.ArgumentParser:
         default="scene",
         help="learn once (paper) or before every kidnapping",
     )
-    p.add_argument("--episodes", type=int, default=33)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--episodes", type=int, default=33, help="kidnappings (paper: 33)")
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the learning phase; kidnapping i uses seed + 1 + i",
+    )
     p.add_argument("--learn-time", type=float, default=5.0, help="seconds per direction")
     p.add_argument(
         "--max-homing",

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from vc_gym.experiments.output import save_figure, write_json
+from vc_gym.validation import positive_float
 
 __all__ = ["evaluate_agent", "PAPER_MEAN_CM", "PAPER_STD_CM"]
 
@@ -143,10 +144,8 @@ def evaluate_agent(
     """
     if episodes < 1 or workers < 1:
         raise ValueError("episodes and workers must be >= 1")
-    if not (np.isfinite(success_radius_m) and success_radius_m > 0):
-        raise ValueError(f"success_radius_m must be > 0, got {success_radius_m}")
-    if not (np.isfinite(max_homing_s) and max_homing_s > 0):
-        raise ValueError(f"max_homing_s must be > 0, got {max_homing_s}")
+    positive_float("success_radius_m", success_radius_m)
+    positive_float("max_homing_s", max_homing_s)
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
     if agent == "pretrained":
