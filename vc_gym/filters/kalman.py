@@ -37,6 +37,7 @@ from vc_gym.angles import circular_mean, circular_std, wrap180, wrap360
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
 from vc_gym.validation import finite_float as _finite
+from vc_gym.validation import positive_float
 
 __all__ = ["KalmanHeadingFilter"]
 
@@ -48,13 +49,6 @@ _BETA = 2.0
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _positive_finite(name: str, value: Any) -> float:
-    v = float(value)
-    if not math.isfinite(v) or v <= 0.0:
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return v
 
 
 def _residual(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -148,7 +142,7 @@ class KalmanHeadingFilter:
         rate_noise_deg_per_s: float = 1.0,
     ) -> None:
         self._with_rate = bool(turn_rate_state)
-        self._rate_spread = _positive_finite("rate_spread_deg_per_s", rate_spread_deg_per_s)
+        self._rate_spread = positive_float("rate_spread_deg_per_s", rate_spread_deg_per_s)
         self._rate_noise = float(rate_noise_deg_per_s)
         if not math.isfinite(self._rate_noise) or self._rate_noise < 0.0:
             raise ValueError(
@@ -235,7 +229,7 @@ class KalmanHeadingFilter:
             On a non-finite heading or a spread outside ``(0, MAX_SPREAD_DEG]``.
         """
         h = _finite("heading_deg", heading_deg)
-        s = _positive_finite("spread_deg", spread_deg)
+        s = positive_float("spread_deg", spread_deg)
         if s > self.MAX_SPREAD_DEG:
             raise ValueError(
                 f"spread_deg must be <= {self.MAX_SPREAD_DEG} (use 180 for 'no idea'), "
@@ -280,7 +274,7 @@ class KalmanHeadingFilter:
         q = _finite("noise_deg", noise_deg)
         if q < 0.0:
             raise ValueError(f"noise_deg must be >= 0, got {noise_deg!r}")
-        step = _positive_finite("dt", dt)
+        step = positive_float("dt", dt)
         ukf = self._ukf
         if self._with_rate:
             ukf.Q = np.diag([q * q, self._rate_noise**2 * step])
@@ -378,7 +372,7 @@ class KalmanHeadingFilter:
             raise TypeError(
                 f"sensor must have a heading_log_likelihood method, got {type(sensor).__name__}"
             )
-        step = _positive_finite("grid_step_deg", grid_step_deg)
+        step = positive_float("grid_step_deg", grid_step_deg)
         n = round(360.0 / step)
         if n < 1 or not math.isclose(n * step, 360.0, rel_tol=0.0, abs_tol=1e-9):
             raise ValueError(f"grid_step_deg must divide 360, got {grid_step_deg!r}")

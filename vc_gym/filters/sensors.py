@@ -7,15 +7,9 @@ import math
 import numpy as np
 
 from vc_gym.angles import wrap180
+from vc_gym.validation import positive_float
 
 __all__ = ["VonMisesHeadingSensor", "GaussianPoseSensor"]
-
-
-def _positive(name: str, value: float) -> float:
-    v = float(value)
-    if not math.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return v
 
 
 def _i0e(kappa: float) -> float:
@@ -43,7 +37,7 @@ class VonMisesHeadingSensor:
     """
 
     def __init__(self, noise_deg: float = 5.0, outlier_prob: float = 0.0):
-        self.noise_deg = _positive("noise_deg", noise_deg)
+        self.noise_deg = positive_float("noise_deg", noise_deg)
         if not 0.0 <= outlier_prob < 1.0:
             raise ValueError(f"outlier_prob must be in [0, 1), got {outlier_prob}")
         self.outlier_prob = float(outlier_prob)
@@ -85,9 +79,11 @@ class GaussianPoseSensor:
     """
 
     def __init__(self, pos_noise_m: float = 0.2, heading_noise_deg: float | None = 10.0):
-        self.pos_noise_m = _positive("pos_noise_m", pos_noise_m)
+        self.pos_noise_m = positive_float("pos_noise_m", pos_noise_m)
         self.heading_noise_deg = (
-            None if heading_noise_deg is None else _positive("heading_noise_deg", heading_noise_deg)
+            None
+            if heading_noise_deg is None
+            else positive_float("heading_noise_deg", heading_noise_deg)
         )
 
     def read(self, true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray:
