@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.compass.synthetic import Panorama, make_panorama, render_view
-from vc_gym.compass.synthetic_room import Room, make_room, render_room_view
 from vc_gym.experiments.real_data import default_real_data_dir
+from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
+from vc_gym.worlds.room import Room, make_room, render_room_view
 
 #: Yaws of the learning frames: 8 body directions x 3 head pans (paper 4.3).
 LEARN_YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.validation import finite_float, nonnegative_float, positive_float
+from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
 
 
 @pytest.mark.parametrize("value", [1, 0.5, np.float32(2.0), np.int64(3)])
@@ -40,3 +40,24 @@ def test_finite_float_converts_and_refuses():
         finite_float("x", float("nan"))
     with pytest.raises(ValueError, match="real number"):
         finite_float("x", "abc")
+
+
+@pytest.mark.parametrize("value", [2, 7, np.int64(3), np.uint8(2)])
+def test_int_at_least_accepts_integers(value):
+    out = int_at_least("width", value, 2)
+    assert out == int(value)
+    assert type(out) is int
+
+
+def test_int_at_least_refuses_small_values():
+    assert int_at_least("n", 0, 0) == 0
+    with pytest.raises(ValueError, match=r"width must be >= 2, got 1"):
+        int_at_least("width", 1, 2)
+    with pytest.raises(ValueError, match=r"n must be >= 0, got -1"):
+        int_at_least("n", np.int32(-1), 0)
+
+
+@pytest.mark.parametrize("value", [2.0, "3", True, None, np.float64(4.0)])
+def test_int_at_least_refuses_non_integers(value):
+    with pytest.raises(ValueError, match=r"width must be an integer >= 2"):
+        int_at_least("width", value, 2)

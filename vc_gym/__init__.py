@@ -14,6 +14,8 @@ ENV_SPECS = {
     "vc_gym/AiboRoom-v0": ("vc_gym.envs.aibo_room:AiboRoomEnv", 1000),
     # ends itself: stop, fall, or its own homing/learning time limits
     "vc_gym/LearnThenHome-v0": ("vc_gym.envs.learn_then_home:LearnThenHomeEnv", None),
+    # the task as a learned agent sees it: compass features in, (walk, turn, stop) out
+    "vc_gym/Homing-v0": ("vc_gym.envs.homing:make_homing_env", None),
 }
 
 

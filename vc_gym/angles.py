@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["wrap180", "wrap360", "circular_mean", "circular_std"]
+__all__ = ["wrap180", "wrap360", "circular_mean", "circular_std", "interp_circular"]
 
 
 def wrap180(angle_deg: ArrayLike) -> np.ndarray | float:
@@ -83,3 +83,34 @@ def circular_std(angle_deg: ArrayLike, weights: ArrayLike | None = None) -> floa
     if r <= 0.0:
         return float("inf")
     return float(np.degrees(np.sqrt(max(-2.0 * math.log(r), 0.0))))
+
+
+def interp_circular(values: np.ndarray, step_deg: float, query_deg: ArrayLike) -> np.ndarray:
+    """Linear interpolation of a function sampled on a circular grid of headings.
+
+    ``values[k]`` is the value at ``k * step_deg``; queries wrap around 360°. Exact
+    where a query falls on the grid; a ``-inf`` neighbour gives ``-inf`` (a
+    log-likelihood that rules a heading out stays ruled out).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(n,)`` samples at ``0, step, ..., (n - 1) step`` degrees.
+    step_deg : float
+        Grid step in degrees (``n * step_deg == 360``).
+    query_deg : array_like
+        Angles to evaluate, any real values (wrapped).
+
+    Returns
+    -------
+    numpy.ndarray
+        Interpolated values, shaped like ``query_deg``.
+    """
+    n = values.size
+    pos = np.mod(np.asarray(query_deg, dtype=np.float64), 360.0) / step_deg
+    i0 = np.floor(pos).astype(np.int64)
+    frac = pos - i0
+    a = values[i0 % n]
+    b = values[(i0 + 1) % n]
+    with np.errstate(invalid="ignore"):
+        return np.where(frac == 0.0, a, (1.0 - frac) * a + frac * b)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from vc_gym.experiments.output import write_json
@@ -16,7 +16,7 @@ __all__ = ["main"]
 def _cmd_demo(args: argparse.Namespace) -> int:
     from vc_gym.experiments.demo import run_demo
 
-    s = run_demo(args.out, seed=args.seed, learn_time_s=args.learn_time)
+    s = run_demo(args.out, seed=args.seed, learn_time_s=args.learn_time, tracker=args.tracker)
     dx, dy = (100 * v for v in s["stop_offset_m"])
     print(
         f"stopped {s['home_error_m'] * 100:.1f} cm from home "
@@ -33,6 +33,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
     result = evaluate_agent(
         agent=args.agent,
+        tracker=args.tracker,
         episodes=args.episodes,
         seed=args.seed,
         learn_time_s=args.learn_time,
@@ -55,7 +56,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from vc_gym.agents.learned import TrainConfig, train
+    from vc_gym.experiments.training import TrainConfig, train
 
     config = TrainConfig(
         algo=args.algo,
@@ -64,6 +65,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         seed=args.seed,
         scene=args.scene,
         learn_time_s=args.learn_time,
+        tracker=args.tracker,
         vec_env="dummy" if args.n_envs == 1 else "subproc",
     )
     s = train(config, args.out, progress=not args.json)
@@ -177,14 +179,65 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     return 0
 
 
+class _SceneChoices:
+    """``choices`` for a ``--scene`` option: ``extra`` and the registered scene names.
+
+    Read from the scene registry only when argparse checks or lists them, so that
+    ``vc-gym --help`` and commands without ``--scene`` do not import PyBullet. A scene
+    registered in this process before :func:`main` runs is accepted too.
+    """
+
+    def __init__(self, *extra: str) -> None:
+        self.extra = extra
+
+    def _names(self) -> tuple[str, ...]:
+        from vc_gym.envs.scenes import scene_names
+
+        return (*self.extra, *scene_names())
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names()
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names())
+
+
 def _cmd_render(args: argparse.Namespace) -> int:
-    from vc_gym.envs.scenes import SCENES
+    from vc_gym.envs.scenes import scene_names
     from vc_gym.experiments.render_scenes import render_scene_pictures
 
-    scenes = tuple(SCENES) if args.scene == "all" else (args.scene,)
+    scenes = scene_names() if args.scene == "all" else (args.scene,)
     for path in render_scene_pictures(args.out, scenes, seed=args.seed, randomize=args.randomize):
         print(f"wrote {path}")
     return 0
+
+
+def _tracker_spec(text: str) -> object:
+    """``--tracker``: a name, ``package.module:factory`` or a JSON ``{"type": ...}``."""
+    if text.lstrip().startswith("{"):
+        try:
+            spec = json.loads(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(f"not a JSON object: {exc}") from None
+        if not isinstance(spec, dict):
+            raise argparse.ArgumentTypeError("a JSON tracker spec must be an object")
+        return spec
+    return text
+
+
+def _add_tracker_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--tracker",
+        default="grid",
+        type=_tracker_spec,
+        metavar="SPEC",
+        help=(
+            "what turns frames and odometry into the pose estimate: grid (the paper's heading "
+            "grid + translational filter, default), particle, kalman, "
+            "'package.module:factory' (your own tracker class or factory), or a JSON "
+            'object such as \'{"type": "particle", "n_particles": 2000}\''
+        ),
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -213,10 +266,16 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("--out", default="vc_gym_demo", metavar="DIR", help="output folder")
-    p.add_argument("--seed", type=int, default=0, help="seed of odometry errors and kidnapping")
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the learning phase; the kidnapping uses seed + 1 (as in evaluate)",
+    )
     p.add_argument(
         "--learn-time", type=float, default=5.0, help="seconds per learning direction (paper: 5)"
     )
+    _add_tracker_option(p)
     p.set_defaults(func=_cmd_demo)
 
     p = sub.add_parser(
@@ -282,6 +341,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="homing seconds before an episode ends as timed out",
     )
     p.add_argument("--workers", type=int, default=2, help="parallel processes")
+    _add_tracker_option(p)
     p.add_argument("--out", metavar="DIR", help="folder for evaluation.json and the plot")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_evaluate)
@@ -304,8 +364,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="vc_gym_agent", metavar="DIR", help="output folder")
     p.add_argument("--n-envs", type=int, default=2, help="parallel environments (processes)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--scene", default="robolab", help="scene to train in")
+    p.add_argument(
+        "--scene",
+        default="robolab",
+        choices=_SceneChoices(),
+        metavar="SCENE",
+        help="scene to train in (default: robolab): %(choices)s",
+    )
     p.add_argument("--learn-time", type=float, default=5.0, help="seconds per learning direction")
+    p.add_argument(
+        "--tracker",
+        default="grid",
+        metavar="NAME",
+        help="tracker of the agent's env: grid (the paper's filters), particle or kalman",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_train)
 
@@ -321,8 +393,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--scene",
         default="all",
-        choices=["all", "robolab", "office", "home", "outdoor_field"],
-        help="which scene (default: all)",
+        choices=_SceneChoices("all"),
+        metavar="SCENE",
+        help="which scene (default: all, every registered scene): %(choices)s",
     )
     p.add_argument("--out", default="vc_gym_scenes", metavar="DIR", help="output folder")
     p.add_argument("--seed", type=int, default=0)

@@ -12,14 +12,61 @@ import json
 import os
 import tempfile
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
 
 from vc_gym.errors import MapFileError
 
-__all__ = ["save_npz_atomic", "load_npz_checked", "json_array", "read_json_array"]
+__all__ = [
+    "json_array",
+    "load_npz_checked",
+    "read_json_array",
+    "save_npz_atomic",
+    "write_atomic",
+]
+
+
+def write_atomic(
+    path: str | os.PathLike, write: Callable[[str], object], mode: int = 0o644
+) -> Path:
+    """Create ``path`` whole or not at all: ``write(tmp)`` fills a temporary file in the
+    same folder, which is then renamed over ``path``.
+
+    A crash or an exception inside ``write`` leaves any previous file at ``path``
+    untouched and no temporary file behind. The file gets permissions ``mode``
+    (``mkstemp`` would make it private; results and models are meant to be shared).
+
+    Parameters
+    ----------
+    path : path-like
+        The file to create or replace; its folder must exist.
+    write : callable
+        ``write(tmp_path)`` writes the content to ``tmp_path`` (a str).
+    mode : int
+        Permission bits of the result.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=folder)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
 
 
 def json_array(obj: object) -> np.ndarray:

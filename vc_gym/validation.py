@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["finite_float", "nonnegative_float", "positive_float"]
+__all__ = ["finite_float", "int_at_least", "nonnegative_float", "positive_float"]
 
 
 def finite_float(name: str, value: object) -> float:
@@ -39,4 +39,35 @@ def nonnegative_float(name: str, value: object) -> float:
     v = _real(name, value)
     if not (math.isfinite(v) and v >= 0):
         raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
+    return v
+
+
+def int_at_least(name: str, value: object, minimum: int) -> int:
+    """``int(value)`` if it is an integer >= ``minimum``, else a ``ValueError``.
+
+    Parameters
+    ----------
+    name : str
+        Name of the argument, used in the error message.
+    value : object
+        The value to check. Python and numpy integers are accepted; bools, floats
+        (even ``2.0``) and strings are refused.
+    minimum : int
+        Smallest allowed value.
+
+    Returns
+    -------
+    int
+        ``value`` as a Python ``int``.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not an integer or is below ``minimum``.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    v = int(value)
+    if v < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {v}")
     return v

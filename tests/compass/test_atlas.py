@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, NotLearnedError, VisualCompass
-from vc_gym.compass.synthetic_room import render_room_view
+from vc_gym.worlds.room import render_room_view
 
 TEST_YAWS = (10.0, 100.0, 200.0, 290.0)
 

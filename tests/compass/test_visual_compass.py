@@ -13,7 +13,7 @@ from vc_gym.compass import (
     VisualCompass,
     wrap180,
 )
-from vc_gym.compass.synthetic import render_view
+from vc_gym.worlds.panorama import render_view
 
 
 def heading_errors(vc, pano, yaws, **cam_kwargs):

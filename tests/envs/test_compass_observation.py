@@ -12,8 +12,8 @@ from gymnasium import spaces
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera
-from vc_gym.compass.synthetic_room import render_room_view
 from vc_gym.envs.compass_observation import CompassObservation
+from vc_gym.worlds.room import render_room_view
 
 
 class RayCastRobot(gym.Env):
@@ -126,10 +126,90 @@ def test_bad_arguments(synthetic_room, room_atlas):
         CompassObservation(env, atlas="atlas.npz")
     with pytest.raises(ValueError, match="belief_bins"):
         CompassObservation(env, room_atlas, belief_bins=7)
-    with pytest.raises(ValueError, match="half_life_s"):
-        CompassObservation(env, room_atlas, half_life_s=float("nan"))
+    with pytest.raises(ValueError, match="unknown tracker"):
+        CompassObservation(env, room_atlas, tracker="kalmann")
     with pytest.raises(ValueError, match="4 spots"):
         CompassObservation(env, room_atlas, n_spots=2).reset(seed=0)
     plain = gym.make("CartPole-v1")
     with pytest.raises(ValueError, match="image"):
         CompassObservation(plain, room_atlas)
+
+
+@pytest.mark.parametrize("tracker", ["grid", "particle", "kalman", {"type": "particle", "seed": 4}])
+def test_every_tracker_plugs_in(synthetic_room, room_atlas, tracker):
+    w = CompassObservation(RayCastRobot(synthetic_room), room_atlas, belief_bins=8, tracker=tracker)
+    obs, info = w.reset(seed=0)
+    for a in ACTIONS[:6]:
+        obs, _, _, _, info = w.step(np.array(a, np.float32))
+    assert w.observation_space.contains(obs)
+    est = info["estimate"]
+    np.testing.assert_allclose(obs["position"], est["position"], atol=1e-5)
+    np.testing.assert_allclose(obs["position_std"], est["position_std_m"], atol=1e-5)
+    th = math.radians(est["heading_deg"])
+    np.testing.assert_allclose(obs["heading"], (math.cos(th), math.sin(th)), atol=1e-6)
+    assert w.tracker_updates == 7 and w.tracker_time_s > 0
+
+
+class DeadReckoning:
+    """A tracker written by a user (outside the package): odometry only, from home."""
+
+    def __init__(self):
+        self.resets = 0
+
+    def reset(self, atlas, camera, dt_s):
+        self.resets += 1
+        self.n = len(atlas)
+        self.pose = (*atlas.home_position, 0.0)
+
+    def update(self, image, head_pan_deg, odometry):
+        from vc_gym.localization import TrackerState
+        from vc_gym.poses import compose
+
+        self.pose = compose(self.pose, tuple(float(v) for v in odometry))
+        belief = np.zeros(360)
+        belief[int(self.pose[2]) % 360] = 1.0
+        return TrackerState(
+            heading_deg=self.pose[2],
+            heading_spread_deg=1.0,
+            position=self.pose[:2],
+            position_std_m=(0.5, 0.5),
+            goodness=np.ones(self.n),
+            belief=belief,
+            atlas_position=self.pose[:2],
+        )
+
+
+def test_a_tracker_from_outside_the_package_runs_a_whole_episode():
+    from vc_gym.agents.scripted import ScriptedHomingPolicy
+    from vc_gym.envs.head_camera import HeadCameraSpec
+
+    task = gym.make(
+        "vc_gym/LearnThenHome-v0",
+        learn_time_s=0.2,
+        max_homing_s=4.0,
+        camera=HeadCameraSpec(52, 40, 56.9),
+    )
+    w = CompassObservation(task, keep_image=False, tracker=DeadReckoning)
+    policy = ScriptedHomingPolicy.for_env(w, settle_time_s=0.0)
+    obs, info = w.reset(seed=2, options={"pose": (1.0, 0.5, 90.0)})
+    assert isinstance(w.tracker, DeadReckoning) and w.tracker.resets == 1
+    steps = 0
+    while steps < 100:
+        steps += 1
+        obs, _, terminated, truncated, info = w.step(policy.predict(obs))
+        assert info["estimate"]["position"] == list(w.tracker.pose[:2])
+        if terminated or truncated:
+            break
+    assert truncated and steps == 40  # 4 s of homing at 10 Hz
+    # it believed it started at home facing east: the home vector points back there
+    x, y, th = w.tracker.pose
+    assert obs["home_vector"] == pytest.approx(
+        (
+            -x * math.cos(math.radians(th)) - y * math.sin(math.radians(th)),
+            x * math.sin(math.radians(th)) - y * math.cos(math.radians(th)),
+        ),
+        abs=1e-5,
+    )
+    w.reset(seed=3)
+    assert w.tracker.resets == 2
+    w.close()

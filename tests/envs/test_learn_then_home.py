@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 import vc_gym  # noqa: F401
-from vc_gym.agents.scripted import LearnThenHomeConfig, ScriptedHomingPolicy
+from vc_gym.agents.scripted import ScriptedHomingPolicy
 from vc_gym.compass import CompassAtlas
 from vc_gym.envs import CompassObservation
+from vc_gym.envs.learning import LearningResult
 
 STILL = np.zeros(5, np.float32)
 WALK = np.array([0.5, 0, 0, 0, 0], np.float32)  # 0.25 m/s straight ahead
@@ -35,38 +36,54 @@ def test_reset_learns_an_atlas_and_kidnaps(env):
     assert fx0 + 0.5 <= x <= fx1 - 0.5 and fy0 + 0.5 <= y <= fy1 - 0.5
     assert info["home_error_m"] == pytest.approx(math.hypot(x, y))
     assert "pose" not in obs
+    result = u.learning_result
+    assert result.atlas is u.atlas and set(result.spots) == set(u.atlas.names)
+    assert len(result.true_path) == 4 * 8 * 2  # 4 spots x 8 directions x 0.2 s at 10 Hz
+    assert 0.8 <= result.odometry_turn_scale <= 1.25
 
 
-@pytest.fixture
-def learner_calls(monkeypatch):
-    """Replace the scripted learning phase by a counter that answers with a fresh token.
+class CountingLearner:
+    """A learner that answers with a fresh token instead of learning.
 
     For tests of the task's rules that do not need a real atlas
     (test_reset_learns_an_atlas_and_kidnaps learns for real).
     """
-    from vc_gym.agents import scripted
 
-    calls = []
+    def __init__(self):
+        self.calls = []
 
-    def fake_learn(self, record=None):
-        calls.append(self)
-        return object()
+    def __call__(self, room, config):
+        self.calls.append((room, config))
+        return LearningResult(atlas=object(), spots={})
 
-    monkeypatch.setattr(scripted.ScriptedLearner, "learn", fake_learn)
-    return calls
+
+@pytest.fixture
+def learner():
+    return CountingLearner()
 
 
 @pytest.mark.parametrize(("relearn", "learnings"), [("scene", 1), ("episode", 3)])
-def test_atlas_is_reused_per_scene_and_relearned_per_episode(learner_calls, relearn, learnings):
-    e = gym.make("vc_gym/LearnThenHome-v0", relearn=relearn)
+def test_atlas_is_reused_per_scene_and_relearned_per_episode(learner, relearn, learnings):
+    e = gym.make("vc_gym/LearnThenHome-v0", relearn=relearn, learner=learner)
     atlases = []
     for seed in (0, 1, 2):
         _, info = e.reset(seed=seed)
         assert info["phase"] == "homing"
         atlases.append(e.unwrapped.atlas)
     e.close()
-    assert len(learner_calls) == learnings
+    assert len(learner.calls) == learnings
     assert len({id(a) for a in atlases}) == learnings
+    room, config = learner.calls[0]
+    assert room is e.unwrapped.room and config.learn_time_s == 5.0
+
+
+def test_a_learner_must_return_a_learning_result():
+    e = gym.make("vc_gym/LearnThenHome-v0", learner=lambda room, config: "atlas")
+    with pytest.raises(TypeError, match="LearningResult"):
+        e.reset(seed=0)
+    e.close()
+    with pytest.raises(ValueError, match="learner"):
+        gym.make("vc_gym/LearnThenHome-v0", learner="scripted")
 
 
 def test_progress_reward_is_distance_gained(env):
@@ -100,8 +117,8 @@ def test_standing_still_for_stop_time_ends_the_episode(env, start, success):
         env.step(STILL)
 
 
-def test_moving_resets_the_stop_clock_and_time_limit_truncates(learner_calls):
-    e = gym.make("vc_gym/LearnThenHome-v0", learn_time_s=0.2, max_homing_s=3.0, stop_time_s=1.0)
+def test_moving_resets_the_stop_clock_and_time_limit_truncates(learner):
+    e = gym.make("vc_gym/LearnThenHome-v0", max_homing_s=3.0, stop_time_s=1.0, learner=learner)
     e.reset(seed=4, options={"pose": (1.0, 1.0, 0.0)})
     turn = np.array([0, 0, 0.5, 0, 0], np.float32)
     for i in range(30):
@@ -117,7 +134,7 @@ def test_scripted_homing_ends_at_home():
     """A short scripted episode on a fixed seed ends within the success radius."""
     e = gym.make("vc_gym/LearnThenHome-v0", learn_time_s=1.0)
     w = CompassObservation(e, keep_image=False)
-    policy = ScriptedHomingPolicy(LearnThenHomeConfig(), dt_s=e.unwrapped.control_dt)
+    policy = ScriptedHomingPolicy.for_env(w)
     obs, info = w.reset(seed=4)  # kidnapped to (0.06, 1.43), heading 29 deg
     for _ in range(600):
         obs, _, terminated, truncated, info = w.step(policy.predict(obs))
@@ -180,8 +197,8 @@ def test_bad_arguments(kwargs):
         gym.make("vc_gym/LearnThenHome-v0", **kwargs)
 
 
-def test_bad_actions_and_closed_env(learner_calls):
-    e = gym.make("vc_gym/LearnThenHome-v0", learn_time_s=0.2)
+def test_bad_actions_and_closed_env(learner):
+    e = gym.make("vc_gym/LearnThenHome-v0", learner=learner)
     with pytest.raises(RuntimeError, match="reset"):
         e.unwrapped.step(STILL)
     e.reset(seed=0)

@@ -12,7 +12,7 @@ import pytest
 from pybullet_utils import bullet_client
 
 from vc_gym.envs import textures
-from vc_gym.envs.scenes import SCENES, Scene, build_scene
+from vc_gym.envs.scenes import SCENES, Scene, build_scene, scene_names
 
 W, H, HFOV = 208, 160, 56.9
 FOV_V = math.degrees(2.0 * math.atan(math.tan(math.radians(HFOV / 2.0)) * H / W))
@@ -57,7 +57,7 @@ def gap(box, field) -> float:
     return math.hypot(dx, dy)
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", scene_names())
 def test_scene_builds_closed_and_varied(bc, name):
     scene = build_scene(bc, name)
     assert scene.name == name
@@ -90,7 +90,7 @@ def test_scene_builds_closed_and_varied(bc, name):
         assert np.abs(uppers[i] - uppers[j]).mean() > 10.0
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", scene_names())
 def test_randomised_scenes_are_seeded_and_canonical_ignores_rng(name):
     def render(seed, randomize):
         client = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
@@ -115,7 +115,7 @@ def test_randomised_scenes_are_seeded_and_canonical_ignores_rng(name):
 
 
 def test_randomised_layouts_keep_the_field_free(bc):
-    for name in SCENES:
+    for name in scene_names():
         for seed in range(4):
             bc.resetSimulation()
             scene = build_scene(bc, name, np.random.default_rng(seed), randomize=True)
@@ -161,8 +161,15 @@ def test_rebuild_after_reset_simulation(bc, private_tmp):
     assert os.listdir(private_tmp) == []
 
 
+def test_builtin_scenes_are_registered_first_in_order():
+    assert SCENES == ("robolab", "office", "home", "outdoor_field")
+    assert scene_names()[: len(SCENES)] == SCENES
+
+
 def test_bad_arguments(bc):
     with pytest.raises(ValueError, match="robolab, office, home, outdoor_field"):
+        build_scene(bc, "moon")
+    with pytest.raises(ValueError, match="register_scene"):
         build_scene(bc, "moon")
     with pytest.raises(ValueError, match="robolab"):
         build_scene(bc, None)  # type: ignore[arg-type]

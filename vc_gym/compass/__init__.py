@@ -14,7 +14,6 @@ from vc_gym.compass.camera import AIBO_HFOV_DEG, AIBO_RESOLUTION, Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.features import log2_bin
-from vc_gym.compass.sensors import AtlasPoseSensor, CompassHeadingSensor
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
 from vc_gym.errors import MapFileError, NotLearnedError
 
@@ -22,13 +21,11 @@ __all__ = [
     "AIBO_HFOV_DEG",
     "AIBO_RESOLUTION",
     "AtlasEstimate",
-    "AtlasPoseSensor",
     "Camera",
     "ColorClasses",
     "CompassAtlas",
     "CompassConfig",
     "CompassEstimate",
-    "CompassHeadingSensor",
     "MapFileError",
     "NotLearnedError",
     "VisualCompass",

@@ -9,7 +9,14 @@ from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
-from vc_gym.envs.scenes import SCENES, Scene, build_scene
+from vc_gym.envs.scenes import (
+    SCENES,
+    Scene,
+    build_scene,
+    register_scene,
+    scene_names,
+    unregister_scene,
+)
 
 __all__ = [
     "LOCOMOTION_MODES",
@@ -23,5 +30,8 @@ __all__ = [
     "Quadruped",
     "Scene",
     "build_scene",
+    "register_scene",
     "render_camera",
+    "scene_names",
+    "unregister_scene",
 ]

@@ -15,7 +15,7 @@ from pybullet_utils import bullet_client
 
 from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
-from vc_gym.envs.scenes import SCENES, Scene, build_scene
+from vc_gym.envs.scenes import Scene, build_scene, check_scene_name
 from vc_gym.envs.top_view import TopView
 
 __all__ = ["AiboRoomEnv"]
@@ -76,7 +76,9 @@ class AiboRoomEnv(gym.Env):
     locomotion="constraint", illumination=1.0, light_direction=None, control_dt=0.1,
     odometry_noise=None, camera=None, render_mode=None)``
 
-    * ``scene``: one of ``vc_gym.envs.SCENES``.
+    * ``scene``: a registered scene name (``vc_gym.envs.scene_names()``: the built-in
+      ``"robolab"``, ``"office"``, ``"home"``, ``"outdoor_field"`` and any registered
+      with ``vc_gym.envs.register_scene``).
     * ``randomize``: domain randomisation of textures, posters, furniture and light,
       drawn from the reset seed.
     * ``locomotion``: ``"constraint"`` (default: the base follows the commanded motion
@@ -114,8 +116,7 @@ class AiboRoomEnv(gym.Env):
                 f"render_mode must be one of {self.metadata['render_modes']} or None, "
                 f"got {render_mode!r}"
             )
-        if scene not in SCENES:
-            raise ValueError(f"scene must be one of {SCENES}, got {scene!r}")
+        check_scene_name(scene)  # a clear ValueError listing the registered scenes
         if locomotion not in LOCOMOTION_MODES:
             raise ValueError(f"locomotion must be one of {LOCOMOTION_MODES}, got {locomotion!r}")
         if not isinstance(randomize, bool):
@@ -279,6 +280,39 @@ class AiboRoomEnv(gym.Env):
         if self.render_mode == "human":
             self.render()
         return obs, 0.0, terminated, False, self._info()
+
+    def velocity_action(
+        self,
+        forward_m_s: float = 0.0,
+        sideways_m_s: float = 0.0,
+        turn_deg_s: float = 0.0,
+        pan_deg: float = 0.0,
+        tilt_deg: float = 0.0,
+    ) -> np.ndarray:
+        """The ``Box(-1, 1, (5,))`` action that commands these velocities and head angles.
+
+        The inverse of the scaling in :meth:`step` (forward by ``robot.max_forward``,
+        sideways by ``robot.max_sideways``, turn by ``robot.max_turn_deg_s``, pan and
+        tilt by their limits), clipped to the action space: the one place where
+        physical commands become actions. Scripted behaviours and action adapters
+        call it.
+        """
+        robot = self.robot
+        pan_lo, pan_hi = robot.pan_limits
+        tilt_lo, tilt_hi = robot.tilt_limits
+        a = np.array(
+            [
+                forward_m_s / robot.max_forward,
+                sideways_m_s / robot.max_sideways,
+                turn_deg_s / robot.max_turn_deg_s,
+                pan_deg / (pan_hi if pan_deg >= 0 else -pan_lo),
+                tilt_deg / (tilt_hi if tilt_deg >= 0 else -tilt_lo),
+            ],
+            np.float32,
+        )
+        if not np.all(np.isfinite(a)):
+            raise ValueError("velocity_action needs finite velocities and angles")
+        return np.clip(a, -1.0, 1.0)
 
     def head_image(self) -> np.ndarray:
         """Render the head camera now (robot body hidden), as a fresh array."""

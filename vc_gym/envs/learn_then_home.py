@@ -10,16 +10,24 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from vc_gym.angles import wrap360
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.learning import (
+    HOME,
+    Learner,
+    LearningConfig,
+    LearningResult,
+    RobotFell,
+    ScriptedLearning,
+    kidnap_pose,
+)
+from vc_gym.poses import compose
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["LearnThenHomeEnv", "LEARNING_MODES"]
 
 LEARNING_MODES = ("scripted", "agent")
 RELEARN_MODES = ("scene", "episode")
-HOME = (0.0, 0.0)
 
 
 @dataclass
@@ -38,9 +46,10 @@ class LearnThenHomeEnv(gym.Env):
     The homing experiment of Sturm & Visser (5.2) on ``vc_gym/AiboRoom-v0``. Home is the
     world origin (robolab: the centre of the kickoff circle); the robot starts there
     facing 0°. In the **learning phase** it learns the panorama at spots around home:
-    either by the scripted behaviour of the paper (``learning="scripted"``: a full turn
-    at home, four spots 1 m away, 8 × 45° each for ``learn_time_s``, normalisation at
-    home; run inside :meth:`reset`) or by the agent itself (``learning="agent"``: the
+    either by a learner run inside :meth:`reset` (``learning="scripted"``; by default
+    the paper's behaviour, :class:`~vc_gym.envs.learning.ScriptedLearning`: a full
+    turn at home, four spots 1 m away, 8 × 45° each for ``learn_time_s``,
+    normalisation at home) or by the agent itself (``learning="agent"``: the
     agent walks and marks frames to learn, see the action space). Then it is
     **kidnapped** to a random pose on the field (``kidnap_margin_m`` inside its edges)
     with a random heading, and **homes**. The learned :class:`CompassAtlas` is the
@@ -91,7 +100,10 @@ class LearnThenHomeEnv(gym.Env):
     ``odometry_noise``, ``camera``, ...) go to ``vc_gym/AiboRoom-v0``.
     ``relearn="scene"`` learns once per scene and reuses the atlas in later episodes
     (the paper learned once and kidnapped many times); ``"episode"`` learns anew in
-    every reset.
+    every reset. ``learner`` is any callable ``learner(room, config) ->
+    LearningResult`` (``room``: the ``AiboRoomEnv`` just reset at home facing 0°,
+    ``config``: the :class:`~vc_gym.envs.learning.LearningConfig` built from the
+    arguments); the result is kept as ``learning_result``.
 
     ## Info
 
@@ -123,6 +135,7 @@ class LearnThenHomeEnv(gym.Env):
         max_spots: int = 8,
         spot_radius_m: float = 0.25,
         compass: CompassConfig | None = None,
+        learner: Learner | None = None,
         **room_kwargs: Any,
     ):
         if learning not in LEARNING_MODES:
@@ -153,17 +166,17 @@ class LearnThenHomeEnv(gym.Env):
             raise ValueError(f"max_spots must be an int >= 1, got {max_spots!r}")
         if compass is not None and not isinstance(compass, CompassConfig):
             raise ValueError(f"compass must be a CompassConfig, got {type(compass).__name__}")
-        from vc_gym.agents.scripted import LearnThenHomeConfig  # the task's learning behaviour
+        if learner is not None and not callable(learner):
+            raise ValueError(f"learner must be callable(room, config), got {learner!r}")
 
         self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
         self.render_mode = render_mode
         self.learning = learning
         self.relearn = relearn
-        self.learn_config = LearnThenHomeConfig(
+        self.learner = learner if learner is not None else ScriptedLearning()
+        self.learn_config = LearningConfig(
             spot_distance_m=float(spot_distance_m),
             learn_time_s=float(learn_time_s),
-            stop_time_s=float(stop_time_s),
-            max_homing_s=float(max_homing_s),
             compass=compass if compass is not None else CompassConfig(),
         )
         self.stop_time_s = float(stop_time_s)
@@ -186,7 +199,9 @@ class LearnThenHomeEnv(gym.Env):
             {**self.room.observation_space.spaces, "phase": spaces.Box(0.0, 1.0, (1,), np.float32)}
         )
 
+        self.home = HOME  # where the robot must return (the world origin)
         self.atlas: CompassAtlas | None = None
+        self.learning_result: LearningResult | None = None
         self._atlas_key: tuple | None = None
         self._phase: str | None = None
         self._frames: list[_Frame] = []
@@ -218,9 +233,11 @@ class LearnThenHomeEnv(gym.Env):
             "still_time_s": self._still_steps * self.control_dt,
         }
 
-    def _kidnap(self, options: dict[str, Any], seed: int | None = None) -> tuple[dict, dict]:
-        from vc_gym.agents.scripted import kidnap_pose
+    def velocity_action(self, **velocities: float) -> np.ndarray:
+        """The room's :meth:`~vc_gym.envs.AiboRoomEnv.velocity_action` (``Box(5)``)."""
+        return self.room.velocity_action(**velocities)
 
+    def _kidnap(self, options: dict[str, Any], seed: int | None = None) -> tuple[dict, dict]:
         if "pose" in options:
             pose = options["pose"]
         else:
@@ -255,7 +272,7 @@ class LearnThenHomeEnv(gym.Env):
             return self._obs(obs), self._info(info)
         obs, info = self.room.reset(seed=room_seed, options={"pose": (*HOME, 0.0)})
         if self.learning == "agent":
-            self.atlas = None
+            self.atlas = self.learning_result = None
             self._frames = []
             self._belief = np.zeros(3)
             self._phase = "learning"
@@ -263,18 +280,19 @@ class LearnThenHomeEnv(gym.Env):
             return self._obs(obs), self._info(info)
         key = self.room.scene_key
         if self.atlas is None or self.relearn == "episode" or key != self._atlas_key:
-            from vc_gym.agents.scripted import RobotFell, ScriptedLearner
-
-            learner = ScriptedLearner(self.room, self.learn_config, progress=False)
-            learner.obs, learner.info = obs, info
-            self.atlas = None
+            self.atlas = self.learning_result = None
             try:
-                self.atlas = learner.learn()
+                result = self.learner(self.room, self.learn_config)
             except RobotFell as exc:
                 raise RuntimeError(
                     "the robot fell during the scripted learning phase; use "
                     "locomotion='constraint' (the default) for this task"
                 ) from exc
+            if not isinstance(result, LearningResult):
+                raise TypeError(
+                    f"the learner must return a LearningResult, got {type(result).__name__}"
+                )
+            self.learning_result, self.atlas = result, result.atlas
             self._atlas_key = key
         obs, info = self._kidnap(options)
         return self._obs(obs), self._info(info)
@@ -323,14 +341,8 @@ class LearnThenHomeEnv(gym.Env):
     def _learning_step(self, a: np.ndarray):
         obs, _, fell, _, info = self.room.step(a[:5])
         self._phase_time += self.control_dt
-        fwd, left, turn = (float(v) for v in obs["odometry"])
-        th = math.radians(self._belief[2])
-        self._belief += [
-            fwd * math.cos(th) - left * math.sin(th),
-            fwd * math.sin(th) + left * math.cos(th),
-            turn,
-        ]
-        self._belief[2] = wrap360(self._belief[2])
+        odometry = tuple(float(v) for v in obs["odometry"])
+        self._belief = np.array(compose(tuple(self._belief), odometry))
         if a[5] > 0:
             pan = float(obs["head"][0])
             self._frames.append(
@@ -343,6 +355,10 @@ class LearnThenHomeEnv(gym.Env):
             return self._obs(obs), -self.fall_penalty, True, False, info
         if a[6] > 0 or self._phase_time >= self.max_learning_s - 1e-9:
             self.atlas = self._atlas_from_frames()
+            self.learning_result = None
+            if self.atlas is not None:
+                spots = dict(zip(self.atlas.names, map(tuple, self.atlas.positions), strict=True))
+                self.learning_result = LearningResult(self.atlas, spots)
             if self.atlas is None:
                 self._phase = None
                 info = self._info(info)

@@ -21,7 +21,6 @@ randomness comes from the ``numpy.random.Generator`` passed in.
 
 from __future__ import annotations
 
-import colorsys
 import functools
 import hashlib
 import itertools
@@ -33,6 +32,9 @@ from collections.abc import Callable, Sequence
 
 import cv2
 import numpy as np
+
+# the colour and noise helpers are shared with vc_gym.worlds; re-exported here
+from vc_gym.worlds.paint import hsv, random_colour, smooth_noise
 
 __all__ = [
     "Canvas",
@@ -69,67 +71,6 @@ _FONT = cv2.FONT_HERSHEY_DUPLEX
 
 
 # ----------------------------------------------------------------------------- colours
-
-
-def hsv(h: float, s: float, v: float) -> np.ndarray:
-    """RGB colour of a hue, saturation and value.
-
-    Parameters
-    ----------
-    h : float
-        Hue; wraps around (0 and 1 are red).
-    s, v : float
-        Saturation and value, clipped to 0..1.
-
-    Returns
-    -------
-    numpy.ndarray
-        ``(3,)`` ``float32`` RGB in 0..255.
-    """
-    r, g, b = colorsys.hsv_to_rgb(h % 1.0, min(max(s, 0.0), 1.0), min(max(v, 0.0), 1.0))
-    return np.array([r, g, b], dtype=np.float32) * np.float32(255.0)
-
-
-def random_colour(
-    rng: np.random.Generator,
-    s: tuple[float, float] = (0.5, 1.0),
-    v: tuple[float, float] = (0.5, 1.0),
-    h: tuple[float, float] = (0.0, 1.0),
-) -> np.ndarray:
-    """A random colour with hue, saturation and value drawn uniformly from the ranges.
-
-    Returns
-    -------
-    numpy.ndarray
-        ``(3,)`` ``float32`` RGB in 0..255.
-    """
-    return hsv(rng.uniform(*h), rng.uniform(*s), rng.uniform(*v))
-
-
-def smooth_noise(rng: np.random.Generator, height: int, width: int, cells: float) -> np.ndarray:
-    """Smooth noise of about unit standard deviation, ``cells`` blobs across the width.
-
-    A coarse grid of normal draws upsampled bicubically: no detail finer than
-    ``width / cells`` pixels, so it never aliases.
-
-    Parameters
-    ----------
-    rng : numpy.random.Generator
-        Source of the draws.
-    height, width : int
-        Size of the result in pixels.
-    cells : float
-        Number of blobs across the width (the grid keeps square cells).
-
-    Returns
-    -------
-    numpy.ndarray
-        ``(height, width)`` ``float32``.
-    """
-    gw = max(2, int(round(cells)) + 1)
-    gh = max(2, int(round(cells * height / max(width, 1))) + 1)
-    grid = rng.standard_normal((gh, gw)).astype(np.float32)
-    return cv2.resize(grid, (int(width), int(height)), interpolation=cv2.INTER_CUBIC)
 
 
 def _u8(img: np.ndarray) -> np.ndarray:

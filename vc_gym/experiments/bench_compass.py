@@ -14,7 +14,7 @@ from collections.abc import Callable
 import numpy as np
 
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
-from vc_gym.compass.synthetic import make_panorama, render_view
+from vc_gym.worlds.panorama import make_panorama, render_view
 
 __all__ = ["bench_compass"]
 

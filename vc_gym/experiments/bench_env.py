@@ -21,7 +21,7 @@ from pybullet_utils import bullet_client
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.envs.head_camera import HeadCameraSpec
 from vc_gym.envs.robot import Quadruped
-from vc_gym.envs.scenes import build_scene
+from vc_gym.envs.scenes import build_scene, check_scene_name
 
 __all__ = ["bench_env"]
 
@@ -89,12 +89,15 @@ def bench_env(
     seed : int
         Seed of actions and env.
     scene : str
-        Scene to benchmark.
+        Registered scene to benchmark (:func:`vc_gym.envs.scenes.scene_names`). The
+        async vector env builds it in worker processes: a scene registered in your own
+        code must be registered there too (see :mod:`vc_gym.envs.scenes`).
     vector : bool
         Also measure 2-env sync and async vector envs.
     """
     if steps < 1 or rounds < 1:
         raise ValueError("steps and rounds must be >= 1")
+    check_scene_name(scene)
     rng = np.random.default_rng(seed)
     env = gym.make(ENV_ID, scene=scene)
     env.reset(seed=seed)

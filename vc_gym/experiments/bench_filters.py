@@ -24,16 +24,16 @@ from vc_gym.compass import (
     AIBO_RESOLUTION,
     Camera,
     CompassConfig,
-    CompassHeadingSensor,
     VisualCompass,
 )
-from vc_gym.compass.synthetic_room import make_room, render_room_view
 from vc_gym.experiments.output import save_figure
 from vc_gym.filters.grid import HeadingGridFilter
 from vc_gym.filters.kalman import KalmanHeadingFilter
 from vc_gym.filters.particle import ParticleFilter
 from vc_gym.filters.sensors import VonMisesHeadingSensor
 from vc_gym.filters.translational import TranslationalFilter
+from vc_gym.localization import CompassHeadingSensor
+from vc_gym.worlds.room import make_room, render_room_view
 
 __all__ = ["bench_filters", "tracking_run"]
 

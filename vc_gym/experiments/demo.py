@@ -1,8 +1,10 @@
 """The package's main job: one learn-then-home episode in the simulated robot lab.
 
 The scripted robot learns the panorama at four spots 1 m around home, is kidnapped to
-a random pose on the field and walks back home with its orientational and translational
-filters (paper 4.3, 5.2). Writes ``summary.json`` and ``demo.png``.
+a random pose on the field and walks back home with its tracker (by default the
+paper's orientational and translational filters, 4.3, 5.2). It is exactly the first
+episode of ``vc-gym evaluate --seed S`` (same env, same policy, same episode runner).
+Writes ``summary.json`` and ``demo.png``.
 """
 
 from __future__ import annotations
@@ -11,13 +13,14 @@ import os
 import time
 from pathlib import Path
 
-import gymnasium as gym
 import numpy as np
 
-import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.agents.scripted import EpisodeRecord, LearnThenHomeConfig, ScriptedLearnThenHome
+from vc_gym.envs.learning import LearningResult, ScriptedLearning
 from vc_gym.envs.top_view import TopView
-from vc_gym.experiments.output import save_figure, write_json
+from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
+from vc_gym.experiments.output import new_figure, save_figure, write_json
+from vc_gym.localization import TrackerSpec, make_tracker
+from vc_gym.validation import positive_float
 
 __all__ = ["run_demo"]
 
@@ -27,20 +30,30 @@ def run_demo(
     seed: int = 0,
     learn_time_s: float = 5.0,
     success_radius_m: float = 0.3,
+    tracker: TrackerSpec = "grid",
+    max_homing_s: float = 60.0,
     progress: bool = True,
 ) -> dict[str, object]:
     """Run one scripted learn-then-home episode in the robolab and save the results.
+
+    The place is learned after ``reset(seed=seed)`` and the robot is kidnapped with
+    ``reset(seed=seed + 1)``: the first episode of
+    :func:`~vc_gym.experiments.evaluate.evaluate_agent` with the same arguments.
 
     Parameters
     ----------
     out_dir : path-like
         Where ``summary.json`` and ``demo.png`` go.
     seed : int
-        Seed of the env (odometry errors) and of the kidnapping pose.
+        Seed of the learning phase; the kidnapping uses ``seed + 1``.
     learn_time_s : float
         Learning time per direction (paper: 5 s).
     success_radius_m : float
         The episode succeeds if the robot stops within this distance of home.
+    tracker : str, dict or callable
+        The tracker (:func:`vc_gym.localization.make_tracker`), default the paper's.
+    max_homing_s : float
+        Homing time limit.
     progress : bool
         Progress bars per phase.
 
@@ -49,54 +62,55 @@ def run_demo(
     dict
         The summary also written to ``summary.json``.
     """
-    if not (np.isfinite(success_radius_m) and success_radius_m > 0):
-        raise ValueError(f"success_radius_m must be > 0, got {success_radius_m}")
-    t0 = time.perf_counter()
+    positive_float("learn_time_s", learn_time_s)
+    positive_float("success_radius_m", success_radius_m)
+    positive_float("max_homing_s", max_homing_s)
+    make_tracker(tracker)  # fail before any work
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    env = gym.make("vc_gym/AiboRoom-v0", scene="robolab", max_episode_steps=10**7)
+    t0 = time.perf_counter()
+    run = make_homing_run(
+        "scripted",
+        tracker=tracker,
+        learn_time_s=learn_time_s,
+        success_radius_m=success_radius_m,
+        max_homing_s=max_homing_s,
+        learner=ScriptedLearning(progress=progress),
+    )
     try:
-        agent = ScriptedLearnThenHome(
-            env, LearnThenHomeConfig(learn_time_s=learn_time_s), progress=progress
-        )
-        record = agent.run(seed=seed)
-        result = record.summary()
+        run.env.reset(seed=seed)  # the learning phase
+        record = run_episode(run, seed=seed + 1, progress=progress)
+        u = run.env.unwrapped
+        learned = u.learning_result
         summary = {
             "task": "learn 4 spots 1 m around home, kidnapping, homing (scripted)",
             "scene": "robolab",
-            "seed": seed,
-            **result,
-            "success": bool(record.stopped and result["home_error_m"] <= success_radius_m),
+            "tracker": tracker if isinstance(tracker, str) else "custom",
+            "learning_seed": seed,
+            **record.summary(),
             "success_radius_m": success_radius_m,
-            "start_pose": list(record.start) if record.start else None,
-            "odometry_turn_calibration": agent.learner.rot_scale,
+            "odometry_turn_calibration": learned.odometry_turn_scale,
         }
-        _plot(out / "demo.png", record, TopView(env.unwrapped.client, env.unwrapped.scene))
+        _plot(out / "demo.png", record, learned, TopView(u.room.client, u.room.scene))
     finally:
-        env.close()
+        run.close()
     summary["duration_s"] = round(time.perf_counter() - t0, 1)
     write_json(out / "summary.json", summary)
     return summary
 
 
-def _plot(path: Path, record: EpisodeRecord, top: TopView) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def _plot(path: Path, record: EpisodeRecord, learned: LearningResult, top: TopView) -> None:
     # world extent of the top view at floor level
     half = (top.size / 2.0) / top.focal * 40.0
     cx, cy = top.center
     extent = (cx - half, cx + half, cy - half, cy + half)
-    fig, (ax, ax2) = plt.subplots(
-        1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1, 1.2]}, constrained_layout=True
-    )
+    fig = new_figure(figsize=(13, 6), layout="constrained")
+    ax, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.2]})
     ax.imshow(top.background, extent=extent, alpha=0.85)
-    learn = np.array(record.learn_true)
+    learn = np.array(learned.true_path)
     if learn.size:
         ax.plot(learn[:, 0], learn[:, 1], color="0.8", lw=1, label="learning walk (true)")
-    for name, (x, y) in record.spots.items():
+    for name, (x, y) in learned.spots.items():
         ax.plot(x, y, "x", color="yellow", ms=10, mew=3)
         ax.annotate(name, (x, y), color="yellow", xytext=(5, 5), textcoords="offset points")
     ax.plot(*record.home, "+", color="white", ms=14, mew=2, label="home")
@@ -105,25 +119,27 @@ def _plot(path: Path, record: EpisodeRecord, top: TopView) -> None:
     if true.size:
         ax.plot(true[:, 0], true[:, 1], color="tab:red", lw=2, label="homing, true")
         ax.plot(est[:, 0], est[:, 1], color="tab:cyan", lw=1.5, ls="--", label="homing, estimated")
-        ax.plot(true[0, 0], true[0, 1], "o", color="tab:red", ms=8, label="kidnapped to")
-    if record.stop is not None:
-        ax.plot(*record.stop, "*", color="magenta", ms=16, label="stop")
+        ax.plot(*record.start_pose[:2], "o", color="tab:red", ms=8, label="kidnapped to")
+    if record.stop_position is not None:
+        ax.plot(*record.stop_position, "*", color="magenta", ms=16, label="stop")
     ax.set_xlim(extent[0], extent[1])
     ax.set_ylim(extent[2], extent[3])
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    err = record.summary()["home_error_m"] if record.stop is not None else float("nan")
-    ax.set_title(f"robolab: learn 4 spots, kidnap, walk home (stop {err * 100:.0f} cm from home)")
+    ax.set_title(
+        f"robolab: learn 4 spots, kidnap, walk home (stop {record.stop_error_m * 100:.0f} cm "
+        "from home)"
+    )
     ax.legend(loc="lower left", fontsize=8)
     if record.heading_error:
         t = np.arange(len(record.heading_error)) * 0.1
-        ax2.plot(t, np.abs(record.heading_error), color="tab:blue")
+        ax2.plot(t, np.maximum(np.abs(record.heading_error), 1e-2), color="tab:blue")
         ax2.set_yscale("log")
         d = np.hypot(true[:, 0] - record.home[0], true[:, 1] - record.home[1])
         ax3 = ax2.twinx()
-        ax3.plot(t, d, color="tab:red", lw=1)
+        ax3.plot(np.arange(len(d)) * 0.1, d, color="tab:red", lw=1)
         ax3.set_ylabel("true distance to home (m)", color="tab:red")
     ax2.set_xlabel("homing time (s)")
     ax2.set_ylabel("|heading error| (deg)", color="tab:blue")
-    ax2.set_title("orientational filter error and distance to home during homing")
+    ax2.set_title("heading error of the tracker and distance to home during homing")
     save_figure(fig, path, dpi=90)

@@ -20,7 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from vc_gym.experiments.output import save_figure, write_json
+from vc_gym.experiments.episode import make_homing_run, run_episode
+from vc_gym.experiments.output import new_figure, save_figure, write_json
+from vc_gym.localization import TrackerSpec, make_tracker
 from vc_gym.validation import positive_float
 
 __all__ = ["evaluate_agent", "PAPER_MEAN_CM", "PAPER_STD_CM"]
@@ -32,76 +34,32 @@ PAPER_STD_CM = (17.0, 15.0)
 _WORKER: dict = {}
 
 
-def _make(
-    agent: str, learn_time_s: float, success_radius_m: float, relearn: str, max_homing_s: float
-):
-    """The evaluation env and a policy ``obs -> action`` (with an optional ``reset``)."""
-    import gymnasium as gym
+def _init_pool_worker(seed: int, run_kwargs: dict) -> None:
+    # numeric libraries single-threaded: the workers are the parallelism (DESIGN.md)
+    import cv2
 
-    import vc_gym  # noqa: F401
-    from vc_gym.agents.scripted import LearnThenHomeConfig, ScriptedHomingPolicy
-    from vc_gym.envs.compass_observation import CompassObservation
-
-    task = {
-        "scene": "robolab",
-        "relearn": relearn,
-        "learn_time_s": learn_time_s,
-        "stop_time_s": 5.0,  # the paper's rule, also for agents trained with a shorter one
-        "success_radius_m": success_radius_m,
-        "max_homing_s": max_homing_s,
-    }
-    if agent == "scripted":
-        env = gym.make("vc_gym/LearnThenHome-v0", **task)
-        env = CompassObservation(env, keep_image=False)
-        policy = ScriptedHomingPolicy(LearnThenHomeConfig(), dt_s=env.unwrapped.control_dt)
-        return env, policy.predict, policy.reset
-    from vc_gym.agents.learned import LearnedHomingAgent
-
-    learned = LearnedHomingAgent(agent)
-    if learned.config.scene != "robolab":
-        task["scene"] = learned.config.scene
-    return learned.make_env(**task), learned.predict, None
+    cv2.setNumThreads(1)
+    _init_worker(seed, run_kwargs)
 
 
-def _init_worker(
-    agent: str, seed: int, learn_time_s: float, radius: float, relearn: str, max_homing_s: float
-) -> None:
-    env, act, reset = _make(agent, learn_time_s, radius, relearn, max_homing_s)
-    env.reset(seed=seed)  # the learning phase (every worker learns the same place)
-    _WORKER.update(env=env, act=act, reset=reset)
+def _init_worker(seed: int, run_kwargs: dict) -> None:
+    run = make_homing_run(**run_kwargs)
+    run.env.reset(seed=seed)  # the learning phase (every worker learns the same place)
+    _WORKER["run"] = run
 
 
 def _episode(episode_seed: int) -> dict:
-    env, act, reset = _WORKER["env"], _WORKER["act"], _WORKER["reset"]
-    obs, info = env.reset(seed=episode_seed)
-    start = [float(v) for v in info["pose"]]
-    if reset is not None:
-        reset()
-    total, decisions = 0.0, 0
-    while True:
-        obs, r, terminated, truncated, info = env.step(act(obs))
-        total += float(r)
-        decisions += 1
-        if terminated or truncated:
-            break
-    stop = [float(v) for v in info["stop_position"]]
-    return {
-        "seed": episode_seed,
-        "start_pose": start,
-        "stop_offset_m": stop,  # home is the origin
-        "home_error_m": float(info["stop_error_m"]),
-        "stopped": bool(info["stopped"]),
-        "success": bool(info["success"]),
-        "fell": bool(info.get("fallen", False)),
-        "timed_out": bool(truncated),
-        "decisions": decisions,
-        "sim_time_s": float(info["sim_time"]),
-        "return": total,
-    }
+    record = run_episode(_WORKER["run"], seed=episode_seed)
+    out = record.summary()
+    out["tracker_ms_per_update"] = (
+        1e3 * record.tracker_time_s / record.tracker_updates if record.tracker_updates else None
+    )
+    return out
 
 
 def evaluate_agent(
     agent: str = "scripted",
+    tracker: TrackerSpec = "grid",
     episodes: int = 33,
     seed: int = 0,
     learn_time_s: float = 5.0,
@@ -120,6 +78,10 @@ def evaluate_agent(
         ``"scripted"`` (:class:`~vc_gym.agents.scripted.ScriptedHomingPolicy`),
         ``"pretrained"`` (the PPO policy shipped with the package) or the path of a
         ``model.zip`` written by ``vc-gym train``.
+    tracker : str or dict
+        The tracker that turns frames and odometry into the agent's estimates:
+        ``"grid"`` (the paper's filters), ``"particle"``, ``"kalman"``, or a
+        ``{"type": name, **kwargs}`` dict (it must be picklable for the workers).
     episodes : int
         Kidnappings (paper: 33).
     seed : int
@@ -152,14 +114,26 @@ def evaluate_agent(
         from vc_gym.agents.learned import PRETRAINED_MODEL
 
         agent = str(PRETRAINED_MODEL)
+    scene = "robolab"
     if agent != "scripted":
         from vc_gym.agents.learned import LearnedHomingAgent
 
-        LearnedHomingAgent(agent)  # fail here, with a clear message, not in a worker
+        # fail here, with a clear message, not in a worker
+        scene = LearnedHomingAgent(agent).scene
+    make_tracker(tracker)  # an unknown tracker fails here too
     from tqdm import tqdm
 
     t0 = time.perf_counter()
-    init = (agent, seed, learn_time_s, success_radius_m, relearn, max_homing_s)
+    run_kwargs = {
+        "agent": agent,
+        "tracker": tracker,
+        "scene": scene,
+        "learn_time_s": learn_time_s,
+        "success_radius_m": success_radius_m,
+        "relearn": relearn,
+        "max_homing_s": max_homing_s,
+    }
+    init = (seed, run_kwargs)
     jobs = [seed + 1 + i for i in range(episodes)]
     workers = min(workers, episodes)
     if workers == 1:
@@ -167,10 +141,10 @@ def evaluate_agent(
         try:
             results = [_episode(j) for j in tqdm(jobs, desc="episodes", disable=not progress)]
         finally:
-            _WORKER.pop("env").close()
+            _WORKER.pop("run").close()
     else:
         ctx = mp.get_context("spawn")
-        with ctx.Pool(workers, initializer=_init_worker, initargs=init) as pool:
+        with ctx.Pool(workers, initializer=_init_pool_worker, initargs=init) as pool:
             results = list(
                 tqdm(
                     pool.imap(_episode, jobs),
@@ -179,11 +153,14 @@ def evaluate_agent(
                     disable=not progress,
                 )
             )
+    costs = [r.pop("tracker_ms_per_update") for r in results]
+    costs = [c for c in costs if c is not None]
     offsets = np.array([r["stop_offset_m"] for r in results]) * 100.0
     dist = np.hypot(offsets[:, 0], offsets[:, 1])
     summary = {
         "agent": agent,
-        "scene": "robolab",
+        "tracker": tracker,
+        "scene": scene,
         "protocol": "learn once, then kidnap every episode (paper 5.2)"
         if relearn == "scene"
         else "learn anew before every kidnapping",
@@ -206,7 +183,14 @@ def evaluate_agent(
         "mean_homing_time_s": float(np.mean([r["sim_time_s"] for r in results]).round(1)),
         "paper_mean_stop_offset_cm": list(PAPER_MEAN_CM),
         "paper_std_stop_offset_cm": list(PAPER_STD_CM),
-        "duration_s": round(time.perf_counter() - t0, 1),
+        "mean_heading_error_deg": float(
+            np.mean([r["mean_heading_error_deg"] or 0.0 for r in results]).round(2)
+        ),
+        "timing": {  # wall time: machine-dependent, not a result
+            "duration_s": round(time.perf_counter() - t0, 1),
+            "tracker_ms_per_update_median": float(np.median(costs).round(3)) if costs else None,
+            "workers": workers,
+        },
         "per_episode": results,
     }
     if out_dir is not None:
@@ -218,12 +202,10 @@ def evaluate_agent(
 
 
 def _plot(path: Path, offsets_cm: np.ndarray, summary: dict) -> None:
-    import matplotlib
+    from matplotlib.patches import Circle
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 5), constrained_layout=True)
+    fig = new_figure(figsize=(6, 5), layout="constrained")
+    ax = fig.subplots()
     ax.scatter(offsets_cm[:, 0], offsets_cm[:, 1], s=25, color="tab:blue", label="stop positions")
     for x, y in ((100, 0), (0, 100), (-100, 0), (0, -100)):
         ax.plot(x, y, "x", color="goldenrod", ms=10, mew=3)
@@ -231,7 +213,7 @@ def _plot(path: Path, offsets_cm: np.ndarray, summary: dict) -> None:
     m = summary["mean_stop_offset_cm"]
     ax.plot(*m, "o", mfc="none", mec="tab:red", ms=12, mew=2, label=f"mean ({m[0]}, {m[1]}) cm")
     ax.plot(*PAPER_MEAN_CM, "s", mfc="none", mec="k", ms=10, label="paper's mean (−22, 12) cm")
-    circle = plt.Circle((0, 0), summary["success_radius_m"] * 100, fill=False, ls="--", color="0.5")
+    circle = Circle((0, 0), summary["success_radius_m"] * 100, fill=False, ls="--", color="0.5")
     ax.add_patch(circle)
     ax.set_aspect("equal")
     # the paper's figure spans ±1.5 m; widen it so that no stop falls off the plot
@@ -241,8 +223,10 @@ def _plot(path: Path, offsets_cm: np.ndarray, summary: dict) -> None:
     ax.set_xlabel("x offset from home (cm)")
     ax.set_ylabel("y offset from home (cm)")
     name = "scripted" if summary["agent"] == "scripted" else Path(summary["agent"]).parent.name
+    tracker = summary["tracker"] if isinstance(summary["tracker"], str) else "custom"
     ax.set_title(
-        f"{name}, {summary['episodes']} kidnappings: success {summary['success_rate']:.0%}, "
+        f"{name} ({tracker} tracker), {summary['episodes']} kidnappings: "
+        f"success {summary['success_rate']:.0%}, "
         f"mean distance {summary['mean_stop_distance_cm']:.0f} cm"
     )
     ax.legend(fontsize=7, loc="upper right")

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
 import numpy as np
 
 from vc_gym.envs.aibo_room import AiboRoomEnv
-from vc_gym.envs.scenes import SCENES
+from vc_gym.envs.scenes import check_scene_name, scene_names
 
 __all__ = ["render_scene_pictures"]
 
@@ -23,7 +24,7 @@ def _write_png(path: Path, rgb: np.ndarray) -> None:
 
 def render_scene_pictures(
     out_dir: str | os.PathLike,
-    scenes: tuple[str, ...] = SCENES,
+    scenes: str | Sequence[str] | None = None,
     seed: int = 0,
     randomize: bool = False,
     n_views: int = 8,
@@ -32,9 +33,39 @@ def render_scene_pictures(
 
     The robot stands at the centre of the field; the strip holds ``n_views`` head
     frames at headings ``0, 360/n, ...`` degrees, left to right, labelled.
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        Output folder (created if missing).
+    scenes : str or sequence of str, optional
+        Registered scene name(s); default: every registered scene
+        (:func:`vc_gym.envs.scenes.scene_names`). All are checked before anything is
+        rendered.
+    seed : int
+        Reset seed (and scene seed when ``randomize``).
+    randomize : bool
+        Domain-randomised scenes.
+    n_views : int
+        Head frames in each strip.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+
+    Raises
+    ------
+    ValueError
+        On an unknown scene name or ``n_views < 1``.
     """
     if n_views < 1:
         raise ValueError(f"n_views must be >= 1, got {n_views}")
+    if isinstance(scenes, str):
+        scenes = (scenes,)
+    scenes = scene_names() if scenes is None else tuple(scenes)
+    for scene in scenes:
+        check_scene_name(scene)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []

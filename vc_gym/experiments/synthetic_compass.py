@@ -17,8 +17,8 @@ from tqdm import tqdm
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
-from vc_gym.compass.synthetic import Panorama, make_panorama, render_view
 from vc_gym.experiments.output import save_figure, write_json
+from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
 
 __all__ = ["run_synthetic_compass"]
 

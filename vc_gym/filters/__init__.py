@@ -2,8 +2,8 @@
 
 Filters never import the compass: any object with ``heading_log_likelihood`` (a
 :class:`HeadingSensor`) or ``pose_log_likelihood`` (a :class:`PoseSensor`) plugs in.
-The compass does through :class:`vc_gym.compass.CompassHeadingSensor` and
-:class:`vc_gym.compass.AtlasPoseSensor`.
+The compass does through :class:`vc_gym.localization.CompassHeadingSensor` and
+:class:`vc_gym.localization.AtlasPoseSensor`.
 """
 
 from vc_gym.filters.estimates import HeadingEstimate

@@ -8,7 +8,7 @@ states it cares about:
 * a :class:`PoseSensor` answers for an array of ``(x, y, θ)`` poses (particles).
 
 Anything with the right method is a sensor: the visual compass and the several-spot
-atlas through the adapters in :mod:`vc_gym.filters.adapters`, the baselines, and the
+atlas through the adapters in :mod:`vc_gym.localization.sensors`, the baselines, and the
 test doubles in :mod:`vc_gym.filters.sensors`.
 
 Log-likelihoods may be shifted by any constant (only differences matter) and may be

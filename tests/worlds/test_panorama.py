@@ -1,4 +1,4 @@
-"""Tests of vc_gym.compass.synthetic: procedural panoramas and pinhole views of them."""
+"""Tests of vc_gym.worlds.panorama: procedural panoramas and pinhole views of them."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 
 from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass.camera import Camera
-from vc_gym.compass.synthetic import (
+from vc_gym.worlds.panorama import (
     PANORAMA_KINDS,
     Panorama,
     equirectangular,

@@ -1,6 +1,6 @@
 """A seeded rectangular room and a tiny 2.5-D ray caster that renders it from any position.
 
-:mod:`vc_gym.compass.synthetic` renders views of a panorama, i.e. of a scene at infinity
+:mod:`vc_gym.worlds.panorama` renders views of a panorama, i.e. of a scene at infinity
 seen from one fixed viewpoint: it can test the compass for rotation only. This module
 renders a room with textured walls from any ``(x, y)`` position inside it, so nearby
 walls look bigger than far ones and features shift against each other as the camera
@@ -41,12 +41,12 @@ A camera pixel ``(u, v)`` of a ``w x h`` view has the camera-frame ray
 ``x = (u - cx) / f`` (right), ``y_up = (cy - v) / f`` (up), forward ``1``, with
 ``f = (w / 2) / tan(hfov / 2)`` and ``(cx, cy)`` the principal point. Pitched up by
 ``θ``: ``forward = cos θ - sin θ y_up``, ``up = sin θ + cos θ y_up``, ``left = -x``;
-the horizontal part ``(forward, left)`` is rotated by the yaw into the world.
+the horizontal part ``(forward, left)`` is rotated by the yaw into the world. These are
+the rays of :func:`vc_gym.worlds.rays.ray_grid`, shared with the panorama renderer.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -54,9 +54,11 @@ import cv2
 import numpy as np
 
 from vc_gym.compass.camera import Camera
-from vc_gym.compass.synthetic import _REMAP_MAX_SIDE, _finite, _hsv, _int_at_least, _noise_2d
 from vc_gym.exposure import gain_table
 from vc_gym.images import check_image
+from vc_gym.validation import finite_float, int_at_least, positive_float
+from vc_gym.worlds.paint import hsv, random_colour, value_noise
+from vc_gym.worlds.rays import REMAP_MAX_SIDE, ray_grid
 
 __all__ = ["Room", "make_room", "render_room_view"]
 
@@ -78,13 +80,6 @@ def _rgb(name: str, value: object) -> tuple[int, int, int]:
             raise ValueError(f"{name} must hold three integers in 0..255, got {value!r}")
         out.append(int(c))
     return out[0], out[1], out[2]
-
-
-def _positive(name: str, value: object) -> float:
-    v = _finite(name, value)
-    if v <= 0.0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
-    return v
 
 
 # ------------------------------------------------------------------------------ Room
@@ -135,14 +130,16 @@ class Room:
     sky_rgb: tuple[int, int, int] = (150, 190, 230)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "width_m", _positive("width_m", self.width_m))
-        object.__setattr__(self, "depth_m", _positive("depth_m", self.depth_m))
-        object.__setattr__(self, "wall_height_m", _positive("wall_height_m", self.wall_height_m))
+        object.__setattr__(self, "width_m", positive_float("width_m", self.width_m))
+        object.__setattr__(self, "depth_m", positive_float("depth_m", self.depth_m))
+        object.__setattr__(
+            self, "wall_height_m", positive_float("wall_height_m", self.wall_height_m)
+        )
         check_image(self.wall_texture, "wall_texture")
-        if self.wall_texture.shape[1] > _REMAP_MAX_SIDE:
+        if self.wall_texture.shape[1] > REMAP_MAX_SIDE:
             raise ValueError(
                 f"wall_texture is {self.wall_texture.shape[1]} pixels wide; it must be "
-                f"at most {_REMAP_MAX_SIDE} (a cv2.remap limit)"
+                f"at most {REMAP_MAX_SIDE} (a cv2.remap limit)"
             )
         object.__setattr__(self, "floor_rgb", _rgb("floor_rgb", self.floor_rgb))
         if self.ceiling_rgb is not None:
@@ -157,7 +154,7 @@ class Room:
     def wall_point(self, s: float) -> tuple[float, float]:
         """World ``(x, y)`` of the point at arc length ``s`` (wrapped) along the walls."""
         w, d = self.width_m, self.depth_m
-        s = float(np.mod(_finite("s", s), self.perimeter_m))
+        s = float(np.mod(finite_float("s", s), self.perimeter_m))
         if s <= d:
             return w / 2.0, -d / 2.0 + s
         if s <= d + w:
@@ -240,24 +237,24 @@ class _Layout:
 
 def _vivid(rng: np.random.Generator) -> np.ndarray:
     """A saturated poster colour."""
-    return _hsv(rng.uniform(), rng.uniform(0.45, 0.95), rng.uniform(0.45, 0.95))
+    return random_colour(rng, s=(0.45, 0.95), v=(0.45, 0.95))
 
 
 def _furniture_colour(rng: np.random.Generator) -> np.ndarray:
     """Grey, beige, wood or (sometimes) a colourful lacquer."""
     kind = rng.uniform()
     if kind < 0.35:  # grey / white laminate
-        return _hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.45, 0.9))
+        return hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.45, 0.9))
     if kind < 0.7:  # wood
-        return _hsv(rng.uniform(0.05, 0.11), rng.uniform(0.35, 0.65), rng.uniform(0.4, 0.8))
-    return _hsv(rng.uniform(), rng.uniform(0.35, 0.8), rng.uniform(0.35, 0.8))
+        return hsv(rng.uniform(0.05, 0.11), rng.uniform(0.35, 0.65), rng.uniform(0.4, 0.8))
+    return hsv(rng.uniform(), rng.uniform(0.35, 0.8), rng.uniform(0.35, 0.8))
 
 
 def _paint_door(rng: np.random.Generator, tex: _Texture, s0: float, s1: float) -> None:
     top = min(rng.uniform(2.0, 2.12), tex.wall_height - 0.1)
-    casing = _hsv(rng.uniform(), rng.uniform(0.0, 0.12), rng.uniform(0.75, 0.95))
+    casing = hsv(rng.uniform(), rng.uniform(0.0, 0.12), rng.uniform(0.75, 0.95))
     if rng.uniform() < 0.6:
-        leaf = _hsv(rng.uniform(0.05, 0.11), rng.uniform(0.4, 0.75), rng.uniform(0.35, 0.7))
+        leaf = hsv(rng.uniform(0.05, 0.11), rng.uniform(0.4, 0.75), rng.uniform(0.35, 0.7))
     else:
         leaf = _vivid(rng) * np.float32(0.8)
     trim = 0.07
@@ -268,15 +265,15 @@ def _paint_door(rng: np.random.Generator, tex: _Texture, s0: float, s1: float) -
 def _paint_window(rng: np.random.Generator, tex: _Texture, s0: float, s1: float) -> None:
     z0 = rng.uniform(0.95, 1.2)
     z1 = min(rng.uniform(2.0, 2.3), tex.wall_height - 0.12)
-    frame = _hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.82, 0.97))
+    frame = hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.82, 0.97))
     trim = 0.07
     tex.rect(s0, s1, z0, z1, frame)
     tex.rect(s0 - 0.05, s1 + 0.05, z0 - 0.06, z0, frame * np.float32(0.85))  # sill
     rows, cols = tex.region(s0 + trim, s1 - trim, z0 + trim, z1 - trim)
     if rows.stop > rows.start and cols.stop > cols.start:
         hue = rng.uniform(0.53, 0.62)
-        lower = _hsv(hue, rng.uniform(0.05, 0.25), rng.uniform(0.78, 0.92))
-        upper = _hsv(hue, rng.uniform(0.25, 0.5), rng.uniform(0.85, 1.0))
+        lower = hsv(hue, rng.uniform(0.05, 0.25), rng.uniform(0.78, 0.92))
+        upper = hsv(hue, rng.uniform(0.25, 0.5), rng.uniform(0.85, 1.0))
         t = np.linspace(1.0, 0.0, rows.stop - rows.start, dtype=np.float32)[:, None, None]
         tex.img[rows, cols] = lower * (1.0 - t) + upper * t
     if z1 - z0 > 0.9 and rng.uniform() < 0.5:  # a transom bar
@@ -287,9 +284,9 @@ def _paint_window(rng: np.random.Generator, tex: _Texture, s0: float, s1: float)
 def _paint_whiteboard(rng: np.random.Generator, tex: _Texture, s0: float, s1: float) -> None:
     z0 = rng.uniform(0.85, 1.0)
     z1 = min(z0 + rng.uniform(1.0, 1.2), tex.wall_height - 0.1)
-    frame = _hsv(0.6, 0.03, rng.uniform(0.55, 0.7))
+    frame = hsv(0.6, 0.03, rng.uniform(0.55, 0.7))
     tex.rect(s0, s1, z0, z1, frame)
-    tex.rect(s0 + 0.04, s1 - 0.04, z0 + 0.04, z1 - 0.04, _hsv(0.6, 0.02, 0.97))
+    tex.rect(s0 + 0.04, s1 - 0.04, z0 + 0.04, z1 - 0.04, hsv(0.6, 0.02, 0.97))
     tex.rect(s0 + 0.1, s1 - 0.1, z0 - 0.05, z0, frame * np.float32(0.8))  # marker tray
     # a few sheets of paper / big scribbles pinned to it
     for _ in range(int(rng.integers(0, 4))):
@@ -298,7 +295,7 @@ def _paint_whiteboard(rng: np.random.Generator, tex: _Texture, s0: float, s1: fl
             continue
         a = rng.uniform(s0 + 0.1, s1 - 0.1 - w)
         b = rng.uniform(z0 + 0.1, z1 - 0.1 - h)
-        tex.rect(a, a + w, b, b + h, _hsv(rng.uniform(), rng.uniform(0.15, 0.6), 0.9))
+        tex.rect(a, a + w, b, b + h, hsv(rng.uniform(), rng.uniform(0.15, 0.6), 0.9))
 
 
 def _paint_poster(
@@ -362,7 +359,7 @@ def _paint_desk(
     # a PC tower under the desk
     if rng.uniform() < 0.7 and s1 - s0 > 0.9:
         a = rng.uniform(s0 + panel + 0.05, s1 - panel - 0.35)
-        case = _hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.1, 0.8))
+        case = hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.1, 0.8))
         tex.rect(a, a + 0.3, 0.02, min(0.5, top - slab - 0.05), case)
     # one or two monitors on the desk
     n_mon = 1 if s1 - s0 < 1.4 else int(rng.integers(1, 3))
@@ -371,15 +368,15 @@ def _paint_desk(
         w = rng.uniform(0.5, 0.65)
         h = rng.uniform(0.32, 0.42)
         lift = rng.uniform(0.1, 0.16)
-        bezel = _hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.08, 0.3))
+        bezel = hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.08, 0.3))
         tex.rect(centre - 0.06, centre + 0.06, top, top + lift + 0.02, bezel)  # stand
         tex.rect(centre - w / 2, centre + w / 2, top + lift, top + lift + h, bezel)
-        screen = _hsv(rng.uniform(), rng.uniform(0.2, 0.7), rng.uniform(0.35, 0.85))
+        screen = hsv(rng.uniform(), rng.uniform(0.2, 0.7), rng.uniform(0.35, 0.85))
         tex.rect(centre - w / 2 + 0.03, centre + w / 2 - 0.03, top + lift + 0.03,
                  top + lift + h - 0.03, screen)  # fmt: skip
         if rng.uniform() < 0.5:  # a window on the screen
             tex.rect(centre - w / 4, centre + w / 4, top + lift + h / 2, top + lift + h - 0.06,
-                     _hsv(rng.uniform(), rng.uniform(0.0, 0.3), 0.92))  # fmt: skip
+                     hsv(rng.uniform(), rng.uniform(0.0, 0.3), 0.92))  # fmt: skip
 
 
 def make_room(
@@ -437,18 +434,18 @@ def make_room(
             f"rng must be a numpy.random.Generator (np.random.default_rng(seed)), got "
             f"{type(rng).__name__}"
         )
-    w = _finite("width_m", width_m)
-    d = _finite("depth_m", depth_m)
-    h = _finite("wall_height_m", wall_height_m)
+    w = positive_float("width_m", width_m)
+    d = positive_float("depth_m", depth_m)
+    h = positive_float("wall_height_m", wall_height_m)
     for name, v in (("width_m", w), ("depth_m", d), ("wall_height_m", h)):
         if v < 2.0:
             raise ValueError(f"{name} must be >= 2 metres, got {v}")
-    ppm = _int_at_least("texture_px_per_m", texture_px_per_m, 10)
+    ppm = int_at_least("texture_px_per_m", texture_px_per_m, 10)
     perimeter = 2.0 * (w + d)
-    if round(perimeter * ppm) > _REMAP_MAX_SIDE or round(h * ppm) > _REMAP_MAX_SIDE:
+    if round(perimeter * ppm) > REMAP_MAX_SIDE or round(h * ppm) > REMAP_MAX_SIDE:
         raise ValueError(
             f"the wall texture would be {round(perimeter * ppm)} x {round(h * ppm)} pixels; "
-            f"sides must be at most {_REMAP_MAX_SIDE}: lower texture_px_per_m or the room size"
+            f"sides must be at most {REMAP_MAX_SIDE}: lower texture_px_per_m or the room size"
         )
 
     tex = _Texture(perimeter, h, ppm)
@@ -456,10 +453,10 @@ def make_room(
     starts = [0.0, d, d + w, 2.0 * d + w]
 
     # --- plain walls with a baseboard
-    wall_rgb = _hsv(rng.uniform(), rng.uniform(0.03, 0.25), rng.uniform(0.78, 0.93))
+    wall_rgb = hsv(rng.uniform(), rng.uniform(0.03, 0.25), rng.uniform(0.78, 0.93))
     tex.img[:] = wall_rgb
     base_h = rng.uniform(0.07, 0.12)
-    base_rgb = _hsv(rng.uniform(), rng.uniform(0.0, 0.3), rng.uniform(0.2, 0.7))
+    base_rgb = hsv(rng.uniform(), rng.uniform(0.0, 0.3), rng.uniform(0.2, 0.7))
     tex.rect(0.0, perimeter, 0.0, base_h, base_rgb)
 
     # --- furniture and things on the walls, biggest first
@@ -520,16 +517,16 @@ def make_room(
         tex.scale(starts[i], starts[i] + lengths[i], 0.0, h + 1.0, float(light[i]))
     cells_x = max(4, int(round(perimeter / 0.5)))
     cells_y = max(2, int(round(h / 0.5)))
-    tex.img *= (1.0 + 0.03 * _noise_2d(rng, tex.width, tex.height, cells_x, cells_y))[:, :, None]
+    tex.img *= (1.0 + 0.03 * value_noise(rng, tex.height, tex.width, cells_x, cells_y))[:, :, None]
     tex.img += rng.standard_normal(tex.img.shape, dtype=np.float32) * np.float32(1.5)
     np.clip(tex.img, 0.0, 255.0, out=tex.img)
     texture = np.rint(tex.img).astype(np.uint8)
 
     if rng.uniform() < 0.55:  # green robot-soccer carpet
-        floor = _hsv(rng.uniform(0.24, 0.4), rng.uniform(0.3, 0.6), rng.uniform(0.35, 0.6))
+        floor = hsv(rng.uniform(0.24, 0.4), rng.uniform(0.3, 0.6), rng.uniform(0.35, 0.6))
     else:  # grey / blue-grey carpet
-        floor = _hsv(rng.uniform(0.5, 0.7), rng.uniform(0.0, 0.2), rng.uniform(0.3, 0.6))
-    ceiling = _hsv(rng.uniform(), rng.uniform(0.0, 0.06), rng.uniform(0.85, 0.96))
+        floor = hsv(rng.uniform(0.5, 0.7), rng.uniform(0.0, 0.2), rng.uniform(0.3, 0.6))
+    ceiling = hsv(rng.uniform(), rng.uniform(0.0, 0.06), rng.uniform(0.85, 0.96))
 
     def as_rgb(c: np.ndarray) -> tuple[int, int, int]:
         r, g, b = (int(v) for v in np.clip(np.rint(c), 0, 255))
@@ -546,23 +543,6 @@ def make_room(
 
 
 # ------------------------------------------------------------------ render_room_view
-
-
-@functools.lru_cache(maxsize=32)
-def _camera_rays(
-    focal: float, pitch_deg: float, cx: float, cy: float, width: int, height: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per-pixel ray ``(forward, left, up)`` in the yawed, un-pitched camera frame."""
-    x = (np.arange(width, dtype=float) - cx) / focal  # right
-    y_up = (cy - np.arange(height, dtype=float)) / focal  # up
-    theta = math.radians(pitch_deg)
-    forward = np.broadcast_to((math.cos(theta) - math.sin(theta) * y_up)[:, None], (height, width))
-    up = np.broadcast_to((math.sin(theta) + math.cos(theta) * y_up)[:, None], (height, width))
-    left = np.broadcast_to(-x[None, :], (height, width))
-    out = (np.ascontiguousarray(forward), np.ascontiguousarray(left), np.ascontiguousarray(up))
-    for a in out:
-        a.flags.writeable = False
-    return out
 
 
 def _tile_hash(ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
@@ -613,7 +593,7 @@ def render_room_view(
         Height of the camera above the floor, ``0 < eye_height_m < wall_height``.
     illumination : float
         Scale of the linear-light intensity, ``> 0``, applied after rendering exactly
-        as in :func:`vc_gym.compass.synthetic.render_view` (sRGB to linear, scale,
+        as in :func:`vc_gym.worlds.panorama.render_view` (sRGB to linear, scale,
         back to sRGB, clip).
 
     Returns
@@ -634,25 +614,23 @@ def render_room_view(
         raise TypeError(f"room must be a Room, got {type(room).__name__}")
     if not isinstance(camera, Camera):
         raise TypeError(f"camera must be a Camera, got {type(camera).__name__}")
-    width = _int_at_least("width", width, 2)
-    height = _int_at_least("height", height, 2)
-    px, py = _finite("x", x), _finite("y", y)
+    width = int_at_least("width", width, 2)
+    height = int_at_least("height", height, 2)
+    px, py = finite_float("x", x), finite_float("y", y)
     hw, hd, wall_h = room.width_m / 2.0, room.depth_m / 2.0, room.wall_height_m
     if not (-hw < px < hw and -hd < py < hd):
         raise ValueError(
             f"camera position ({px}, {py}) must be strictly inside the room "
             f"(-{hw}, {hw}) x (-{hd}, {hd})"
         )
-    eye = _finite("eye_height_m", eye_height_m)
-    if not 0.0 < eye < wall_h:
+    eye = positive_float("eye_height_m", eye_height_m)
+    if not eye < wall_h:
         raise ValueError(f"eye_height_m must be in (0, {wall_h}), got {eye_height_m!r}")
-    illum = _finite("illumination", illumination)
-    if illum <= 0.0:
-        raise ValueError(f"illumination must be > 0, got {illumination!r}")
+    illum = positive_float("illumination", illumination)
 
-    cx, cy = camera.center(width, height)
     focal = float(camera.focal_px(width))
-    fw, lw, up = _camera_rays(focal, float(camera.pitch_deg), float(cx), float(cy), width, height)
+    rays = ray_grid(camera, width, height)
+    fw, lw, up = rays.forward, rays.left, rays.up
     yaw = math.radians(float(camera.yaw_deg))
     c, s = math.cos(yaw), math.sin(yaw)
     dx = c * fw - s * lw

@@ -35,13 +35,13 @@ which looks at::
     azimuth   = yaw + atan2(left, forward)
     elevation = atan2(up, hypot(forward, left))
 
-(:meth:`Camera.column_offsets_deg` is the azimuth part of this at a given row.)
+These rays come from :func:`vc_gym.worlds.rays.ray_grid`, which the ray-cast room
+(:mod:`vc_gym.worlds.room`) shares. (:meth:`Camera.column_offsets_deg` is the azimuth
+part of this at a given row.)
 """
 
 from __future__ import annotations
 
-import colorsys
-import functools
 import math
 from dataclasses import dataclass
 from numbers import Integral
@@ -53,7 +53,9 @@ from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass.camera import Camera
 from vc_gym.exposure import gain_table
 from vc_gym.images import check_image
-from vc_gym.validation import finite_float as _finite
+from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
+from vc_gym.worlds.paint import hsv, random_colour, value_noise
+from vc_gym.worlds.rays import REMAP_MAX_SIDE, ray_grid
 
 __all__ = ["Panorama", "PANORAMA_KINDS", "make_panorama", "render_view", "equirectangular"]
 
@@ -69,16 +71,8 @@ _VERTICAL_PAD = {
     cv2.INTER_CUBIC: 2,
     cv2.INTER_LANCZOS4: 4,
 }
-# cv2.remap refuses sources with a side of SHRT_MAX (32767) pixels or more.
-_REMAP_MAX_SIDE = 32766
-
-
-def _int_at_least(name: str, value: object, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, Integral):
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    if int(value) < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
+#: Saturation and value ranges of the "any colour" items (rugs, books, posters, ...).
+_VARIED = {"s": (0.15, 0.9), "v": (0.25, 0.95)}
 
 
 # --------------------------------------------------------------------------- Panorama
@@ -121,8 +115,8 @@ class Panorama:
 
     def __post_init__(self) -> None:
         check_image(self.image, "panorama image")
-        top = _finite("elev_top_deg", self.elev_top_deg)
-        bottom = _finite("elev_bottom_deg", self.elev_bottom_deg)
+        top = finite_float("elev_top_deg", self.elev_top_deg)
+        bottom = finite_float("elev_bottom_deg", self.elev_bottom_deg)
         if not (-90.0 <= top <= 90.0 and -90.0 <= bottom <= 90.0):
             raise ValueError(
                 f"elev_top_deg and elev_bottom_deg must be in [-90, 90], got {top}, {bottom}"
@@ -133,7 +127,7 @@ class Panorama:
             )
         object.__setattr__(self, "elev_top_deg", top)
         object.__setattr__(self, "elev_bottom_deg", bottom)
-        object.__setattr__(self, "azimuth0_deg", _finite("azimuth0_deg", self.azimuth0_deg))
+        object.__setattr__(self, "azimuth0_deg", finite_float("azimuth0_deg", self.azimuth0_deg))
 
     @property
     def width(self) -> int:
@@ -198,25 +192,6 @@ def equirectangular(image: np.ndarray, azimuth0_deg: float = 0.0) -> Panorama:
 # ------------------------------------------------------------------------ render_view
 
 
-@functools.lru_cache(maxsize=32)
-def _ray_grid(
-    focal: float, pitch_deg: float, cx: float, cy: float, width: int, height: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Azimuth offset from the yaw and elevation (degrees) of every pixel's ray."""
-    x = (np.arange(width, dtype=float) - cx) / focal  # right
-    y_up = (cy - np.arange(height, dtype=float)) / focal  # up
-    theta = math.radians(pitch_deg)
-    forward = (math.cos(theta) - math.sin(theta) * y_up)[:, None]
-    up = (math.sin(theta) + math.cos(theta) * y_up)[:, None]
-    left = -x[None, :]
-    az_offset = np.degrees(np.arctan2(left, forward))
-    elevation = np.degrees(np.arctan2(up, np.hypot(forward, left)))
-    elevation = np.broadcast_to(elevation, az_offset.shape).copy()
-    az_offset.flags.writeable = False
-    elevation.flags.writeable = False
-    return az_offset, elevation
-
-
 def render_view(
     pano: Panorama,
     camera: Camera,
@@ -273,11 +248,9 @@ def render_view(
         raise TypeError(f"pano must be a Panorama, got {type(pano).__name__}")
     if not isinstance(camera, Camera):
         raise TypeError(f"camera must be a Camera, got {type(camera).__name__}")
-    width = _int_at_least("width", width, 2)
-    height = _int_at_least("height", height, 2)
-    illum = _finite("illumination", illumination)
-    if illum <= 0.0:
-        raise ValueError(f"illumination must be > 0, got {illumination!r}")
+    width = int_at_least("width", width, 2)
+    height = int_at_least("height", height, 2)
+    illum = positive_float("illumination", illumination)
     if (
         isinstance(interpolation, bool)
         or not isinstance(interpolation, Integral)
@@ -290,21 +263,14 @@ def render_view(
     pw, ph = pano.width, pano.height
     interpolation = int(interpolation)
     pad = _VERTICAL_PAD[interpolation]
-    if pw > _REMAP_MAX_SIDE or ph + 2 * pad > _REMAP_MAX_SIDE:
+    if pw > REMAP_MAX_SIDE or ph + 2 * pad > REMAP_MAX_SIDE:
         raise ValueError(
             f"panorama of {pw}x{ph} pixels is too large for cv2.remap (sides must be < 32767)"
             "; downscale it first"
         )
 
-    cx, cy = camera.center(width, height)
-    az_offset, elevation = _ray_grid(
-        float(camera.focal_px(width)),
-        float(camera.pitch_deg),
-        float(cx),
-        float(cy),
-        width,
-        height,
-    )
+    rays = ray_grid(camera, width, height)
+    az_offset, elevation = rays.azimuth_offset_deg, rays.elevation_deg
     # column = (azimuth0 - yaw - offset) W / 360 - 0.5, wrapped into [0, W)
     shift = math.fmod(pano.azimuth0_deg - float(camera.yaw_deg), 360.0)
     scale = pw / 360.0
@@ -333,36 +299,6 @@ def render_view(
 
 
 # ---------------------------------------------------------------------- make_panorama
-
-
-def _hsv(h: float, s: float, v: float) -> np.ndarray:
-    """RGB colour (float32, 0..255) from hue (turns, wrapped), saturation and value."""
-    r, g, b = colorsys.hsv_to_rgb(h % 1.0, min(max(s, 0.0), 1.0), min(max(v, 0.0), 1.0))
-    return np.array([r, g, b], dtype=np.float32) * np.float32(255.0)
-
-
-def _random_colour(rng: np.random.Generator) -> np.ndarray:
-    """A colour of varied hue, saturation and brightness."""
-    return _hsv(rng.uniform(), rng.uniform(0.15, 0.9), rng.uniform(0.25, 0.95))
-
-
-def _smoothstep(t: np.ndarray) -> np.ndarray:
-    return t * t * (3.0 - 2.0 * t)
-
-
-def _noise_2d(
-    rng: np.random.Generator, width: int, height: int, cells_x: int, cells_y: int
-) -> np.ndarray:
-    """Smooth value noise in [-1, 1], shape ``(height, width)``, periodic in x."""
-    knots = rng.uniform(-1.0, 1.0, (cells_y + 1, cells_x)).astype(np.float32)
-    tx = (np.arange(width) + 0.5) * (cells_x / width)
-    i0 = np.floor(tx).astype(np.intp)
-    wx = _smoothstep(tx - i0).astype(np.float32)
-    rows = knots[:, i0 % cells_x] * (1.0 - wx) + knots[:, (i0 + 1) % cells_x] * wx
-    ty = (np.arange(height) + 0.5) * (cells_y / height)
-    j0 = np.floor(ty).astype(np.intp)
-    wy = _smoothstep(ty - j0).astype(np.float32)[:, None]
-    return rows[j0] * (1.0 - wy) + rows[np.minimum(j0 + 1, cells_y)] * wy
 
 
 class _Canvas:
@@ -439,26 +375,26 @@ def _draw_room(rng: np.random.Generator, canvas: _Canvas) -> None:
     z = np.float32(cam_h) + dist.astype(np.float32)[None, :] * tan_e[:, None]
 
     # --- walls: one paint, lit differently per wall (the corners become vertical edges)
-    wall_rgb = _hsv(rng.uniform(), rng.uniform(0.05, 0.4), rng.uniform(0.65, 0.92))
+    wall_rgb = hsv(rng.uniform(), rng.uniform(0.05, 0.4), rng.uniform(0.65, 0.92))
     light = rng.uniform(0.72, 1.05, 4).astype(np.float32)[wall]
     img[:] = wall_rgb * light[None, :, None]
-    img *= (1.0 + 0.04 * _noise_2d(rng, width, height, 60, 15))[:, :, None]
+    img *= (1.0 + 0.04 * value_noise(rng, height, width, 60, 15))[:, :, None]
 
     # --- baseboard
     base_h = rng.uniform(0.06, 0.12)
-    base_rgb = _hsv(rng.uniform(), rng.uniform(0.0, 0.3), rng.uniform(0.2, 0.95))
+    base_rgb = hsv(rng.uniform(), rng.uniform(0.0, 0.3), rng.uniform(0.2, 0.95))
     img[(z >= 0) & (z < base_h)] = base_rgb * 0.95
 
     # --- floor: carpet (green or grey) with coarse texture, maybe a rug
     if rng.uniform() < 0.55:
-        carpet = _hsv(rng.uniform(0.22, 0.42), rng.uniform(0.2, 0.55), rng.uniform(0.3, 0.6))
+        carpet = hsv(rng.uniform(0.22, 0.42), rng.uniform(0.2, 0.55), rng.uniform(0.3, 0.6))
     else:
-        carpet = _hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.3, 0.65))
+        carpet = hsv(rng.uniform(), rng.uniform(0.0, 0.1), rng.uniform(0.3, 0.65))
     r0 = int(np.searchsorted(-el, 0.0, side="right"))  # first row below the horizon
     rows = slice(r0, height)  # every floor pixel is in these rows
     n_rows = height - r0
-    tex = 0.10 * _noise_2d(rng, width, n_rows, 72, 9) + 0.05 * _noise_2d(
-        rng, width, n_rows, 180, 22
+    tex = 0.10 * value_noise(rng, n_rows, width, 72, 9) + 0.05 * value_noise(
+        rng, n_rows, width, 180, 22
     )
     floor_img = carpet[None, None, :] * (1.0 + tex)[:, :, None]
     np.copyto(img[rows], floor_img, where=(z[rows] < 0)[:, :, None])
@@ -473,8 +409,8 @@ def _draw_room(rng: np.random.Generator, canvas: _Canvas) -> None:
         outer = (np.abs(gx - rx) < hx) & (np.abs(gy - ry) < hy)
         inner = (np.abs(gx - rx) < hx - border) & (np.abs(gy - ry) < hy - border)
         floor = z[rows] < 0
-        img[rows][outer & floor] = _random_colour(rng)
-        img[rows][inner & floor] = _random_colour(rng)
+        img[rows][outer & floor] = random_colour(rng, **_VARIED)
+        img[rows][inner & floor] = random_colour(rng, **_VARIED)
 
     # --- things on the walls. Floor-standing items stay below 0.95 m, wall-mounted
     # ones above 1.0 m; doors and bookcases take both layers.
@@ -506,13 +442,13 @@ def _draw_room(rng: np.random.Generator, canvas: _Canvas) -> None:
         _draw_room_item(rng, canvas, kind, cols, u, hw, zb, wall_cols, room_h, width_m)
 
     # --- ceiling
-    ceiling_rgb = _hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.82, 0.96))
+    ceiling_rgb = hsv(rng.uniform(), rng.uniform(0.0, 0.08), rng.uniform(0.82, 0.96))
     ceiling = z[:r0] > room_h  # only rows above the horizon can see the ceiling
     if ceiling.any():
         rows = slice(0, int(np.flatnonzero(ceiling.any(axis=1))[-1]) + 1)
         # a little darker towards the far walls
         shade = 1.0 - 0.1 * dist[None, :] / (1.0 + dist[None, :])
-        shade = shade * (1.0 - 0.06 * _noise_2d(rng, width, rows.stop, 36, 4))
+        shade = shade * (1.0 - 0.06 * value_noise(rng, rows.stop, width, 36, 4))
         ceiling_img = ceiling_rgb[None, None, :] * shade.astype(np.float32)[:, :, None]
         np.copyto(img[rows], ceiling_img, where=ceiling[rows][:, :, None])
 
@@ -547,15 +483,15 @@ def _draw_room_item(
     if kind == "door":
         top = rng.uniform(1.9, 2.15)
         if rng.uniform() < 0.5:
-            leaf = _hsv(rng.uniform(0.05, 0.11), rng.uniform(0.4, 0.75), rng.uniform(0.3, 0.65))
+            leaf = hsv(rng.uniform(0.05, 0.11), rng.uniform(0.4, 0.75), rng.uniform(0.3, 0.65))
         else:
-            leaf = _random_colour(rng)
-        casing = _hsv(rng.uniform(), rng.uniform(0.0, 0.15), rng.uniform(0.75, 0.95))
+            leaf = random_colour(rng, **_VARIED)
+        casing = hsv(rng.uniform(), rng.uniform(0.0, 0.15), rng.uniform(0.75, 0.95))
         canvas.paint(cols, band(0.0, top + 0.08), casing)
         canvas.paint(cols, band(0.0, top) & inside(0.12), leaf)
     elif kind == "bookcase":
         top = rng.uniform(1.3, 2.0)
-        frame = _random_colour(rng)
+        frame = random_colour(rng, **_VARIED)
         canvas.paint(cols, band(0.0, top), frame)
         n_shelves = int(rng.integers(3, 6))
         board = rng.uniform(0.04, 0.07)
@@ -571,16 +507,16 @@ def _draw_room_item(
                 if rng.uniform() < 0.7:
                     book_top = lo_in + rng.uniform(0.55, 0.95) * (hi_in - lo_in)
                     m = band(lo_in, book_top) & (u[None, :] <= x) & (u[None, :] > x - w)
-                    canvas.paint(cols, m & inside(0.1), _random_colour(rng))
+                    canvas.paint(cols, m & inside(0.1), random_colour(rng, **_VARIED))
                 x -= w
     elif kind == "window":
         z0, z1 = rng.uniform(1.0, 1.2), min(rng.uniform(2.0, 2.3), room_h - 0.15)
-        frame = _hsv(rng.uniform(), rng.uniform(0.0, 0.12), rng.uniform(0.8, 0.97))
+        frame = hsv(rng.uniform(), rng.uniform(0.0, 0.12), rng.uniform(0.8, 0.97))
         canvas.paint(cols, band(z0, z1), frame)
         t = np.clip((zb - z0) / (z1 - z0), 0.0, 1.0)
         hue = rng.uniform(0.52, 0.62)
-        lower = _hsv(hue, rng.uniform(0.05, 0.25), rng.uniform(0.75, 0.9))
-        upper = _hsv(hue, rng.uniform(0.2, 0.5), rng.uniform(0.85, 1.0))
+        lower = hsv(hue, rng.uniform(0.05, 0.25), rng.uniform(0.75, 0.9))
+        upper = hsv(hue, rng.uniform(0.2, 0.5), rng.uniform(0.85, 1.0))
         mullion = max(0.07, 0.5 / hw)
         pane_mask = band(z0 + 0.06, z1 - 0.06) & inside(0.1) & (au > mullion)
         if pane_mask.any():
@@ -589,18 +525,20 @@ def _draw_room_item(
             block[pane_mask] = sky[pane_mask]
             canvas.img[:, cols] = block
         if rng.uniform() < 0.6:  # curtains on both sides
-            curtain = _random_colour(rng)
+            curtain = random_colour(rng, **_VARIED)
             canvas.paint(cols, band(z0 - 0.25, z1 + 0.1) & ~inside(0.22, 1.0), curtain)
     elif kind == "cabinet":
         top = rng.uniform(0.45, 0.95)
-        body = _random_colour(rng)
-        slab = body * rng.uniform(0.55, 0.8) if rng.uniform() < 0.5 else _random_colour(rng)
+        body = random_colour(rng, **_VARIED)
+        slab = (
+            body * rng.uniform(0.55, 0.8) if rng.uniform() < 0.5 else random_colour(rng, **_VARIED)
+        )
         canvas.paint(cols, band(0.0, top), body)
         canvas.paint(cols, band(top - rng.uniform(0.04, 0.08), top), slab)
         canvas.paint(cols, band(0.0, 0.07), body * 0.4)  # plinth shadow
     elif kind == "table":
         top = rng.uniform(0.6, 0.8)
-        wood = _random_colour(rng)
+        wood = random_colour(rng, **_VARIED)
         thick = rng.uniform(0.05, 0.09)
         shadow = wall_cols[None, :, :] * np.float32(rng.uniform(0.45, 0.65))
         under = band(0.0, top - thick)
@@ -613,15 +551,15 @@ def _draw_room_item(
     else:  # poster / painting
         z0 = rng.uniform(1.05, 1.5)
         z1 = min(z0 + max(rng.uniform(0.5, 1.2) * width_m, 0.25), room_h - 0.2)
-        outer = _random_colour(rng)
+        outer = random_colour(rng, **_VARIED)
         canvas.paint(cols, band(z0, z1), outer)
         inset = rng.uniform(0.08, 0.2)
         dz = inset * (z1 - z0)
         inner = band(z0 + dz, z1 - dz) & inside(inset)
-        canvas.paint(cols, inner, _random_colour(rng))
+        canvas.paint(cols, inner, random_colour(rng, **_VARIED))
         if rng.uniform() < 0.5:  # two-tone picture (a "landscape")
             split = z0 + dz + rng.uniform(0.3, 0.6) * (z1 - z0 - 2 * dz)
-            canvas.paint(cols, inner & (zb < split), _random_colour(rng))
+            canvas.paint(cols, inner & (zb < split), random_colour(rng, **_VARIED))
 
 
 def _draw_outdoor(rng: np.random.Generator, canvas: _Canvas) -> None:
@@ -633,24 +571,25 @@ def _draw_outdoor(rng: np.random.Generator, canvas: _Canvas) -> None:
 
     # --- sky: gradient from a pale horizon to a deeper zenith, soft coarse clouds
     hue = rng.uniform(0.54, 0.63)
-    horizon = _hsv(hue + rng.uniform(-0.03, 0.03), rng.uniform(0.08, 0.25), rng.uniform(0.85, 0.97))
-    zenith = _hsv(hue, rng.uniform(0.45, 0.75), rng.uniform(0.65, 0.9))
+    horizon = hsv(hue + rng.uniform(-0.03, 0.03), rng.uniform(0.08, 0.25), rng.uniform(0.85, 0.97))
+    zenith = hsv(hue, rng.uniform(0.45, 0.75), rng.uniform(0.65, 0.9))
     t = (np.clip(el / 45.0, 0.0, 1.0) ** 0.6).astype(np.float32)[:, None, None]
     img[:] = horizon * (1.0 - t) + zenith * t
-    clouds = _noise_2d(rng, width, height, 24, 8) + 0.5 * _noise_2d(rng, width, height, 60, 20)
+    clouds = value_noise(rng, height, width, 24, 8) + 0.5 * value_noise(rng, height, width, 60, 20)
     cover = np.clip((clouds - rng.uniform(0.1, 0.6)) / 0.35, 0.0, 1.0)
     cover *= np.clip((el - 2.0) / 10.0, 0.0, 1.0).astype(np.float32)[:, None]
-    cloud_rgb = _hsv(hue, 0.03, rng.uniform(0.9, 1.0))
+    cloud_rgb = hsv(hue, 0.03, rng.uniform(0.9, 1.0))
     img += (cloud_rgb - img) * cover[:, :, None]
 
     # --- grass below the horizon: darker and hazier far away, coarse patches
     g_hue, g_sat = rng.uniform(0.2, 0.32), rng.uniform(0.4, 0.7)
-    near = _hsv(g_hue, g_sat, rng.uniform(0.5, 0.7))
-    far = _hsv(g_hue + 0.02, g_sat * 0.6, rng.uniform(0.4, 0.55))
+    near = hsv(g_hue, g_sat, rng.uniform(0.5, 0.7))
+    far = hsv(g_hue + 0.02, g_sat * 0.6, rng.uniform(0.4, 0.55))
     ground = el < 0
     tg = (np.clip(-el / 45.0, 0.0, 1.0) ** 0.5).astype(np.float32)[ground][:, None, None]
-    patches = 0.12 * _noise_2d(rng, width, int(ground.sum()), 48, 10) + 0.05 * _noise_2d(
-        rng, width, int(ground.sum()), 150, 30
+    n_ground = int(ground.sum())
+    patches = 0.12 * value_noise(rng, n_ground, width, 48, 10) + 0.05 * value_noise(
+        rng, n_ground, width, 150, 30
     )
     img[ground] = (far * (1.0 - tg) + near * tg) * (1.0 + patches)[:, :, None]
 
@@ -677,13 +616,13 @@ def _draw_outdoor(rng: np.random.Generator, canvas: _Canvas) -> None:
         top = rng.uniform(4.0, 22.0)
         base = -rng.uniform(0.0, 1.0)
         e = el[:, None]
-        body = _hsv(rng.uniform(), rng.uniform(0.05, 0.45), rng.uniform(0.4, 0.85))
+        body = hsv(rng.uniform(), rng.uniform(0.05, 0.45), rng.uniform(0.4, 0.85))
         canvas.paint(cols, (e >= base) & (e < top) & (u >= 0), body)
         canvas.paint(cols, (e >= base) & (e < top) & (u < 0), body * rng.uniform(0.6, 0.8))
         roof_h = rng.uniform(0.1, 0.2) * (top - base)
-        canvas.paint(cols, (e >= top - roof_h) & (e < top), _random_colour(rng) * 0.6)
+        canvas.paint(cols, (e >= top - roof_h) & (e < top), random_colour(rng, **_VARIED) * 0.6)
         if top - base > 9.0 and hw > 6.0 and rng.uniform() < 0.7:
-            glass = _hsv(rng.uniform(0.5, 0.65), rng.uniform(0.2, 0.5), rng.uniform(0.2, 0.45))
+            glass = hsv(rng.uniform(0.5, 0.65), rng.uniform(0.2, 0.5), rng.uniform(0.2, 0.45))
             cell_e, cell_a = rng.uniform(3.5, 5.0), rng.uniform(4.5, 7.0)
             fe = np.mod(e - base, cell_e) / cell_e  # position within a window cell
             fa = np.mod(rel[None, :] + hw, cell_a) / cell_a
@@ -704,9 +643,9 @@ def _draw_outdoor(rng: np.random.Generator, canvas: _Canvas) -> None:
         canvas.paint(
             cols,
             (np.abs(a) < max(0.16 * hw, 0.4)) & (e >= base) & (e < base + trunk + crown_h),
-            _hsv(rng.uniform(0.05, 0.1), rng.uniform(0.4, 0.7), rng.uniform(0.2, 0.4)),
+            hsv(rng.uniform(0.05, 0.1), rng.uniform(0.4, 0.7), rng.uniform(0.2, 0.4)),
         )
-        leaves = _hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.85), rng.uniform(0.18, 0.5))
+        leaves = hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.85), rng.uniform(0.18, 0.5))
         bottom = base + trunk
         if rng.uniform() < 0.6:  # round crown
             ce = bottom + crown_h / 2.0
@@ -722,9 +661,9 @@ def _draw_outdoor(rng: np.random.Generator, canvas: _Canvas) -> None:
         ce, he = rng.uniform(-30.0, -4.0), rng.uniform(2.0, 7.0)
         m = ((rel[None, :] / hw) ** 2 + ((el[:, None] - ce) / he) ** 2 <= 1.0) & (el[:, None] >= ce)
         if rng.uniform() < 0.5:
-            colour = _hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.8), rng.uniform(0.2, 0.45))
+            colour = hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.8), rng.uniform(0.2, 0.45))
         else:
-            colour = _random_colour(rng)
+            colour = random_colour(rng, **_VARIED)
         canvas.paint(cols, m, colour)
 
 
@@ -782,13 +721,11 @@ def make_panorama(
             f"rng must be a numpy.random.Generator (np.random.default_rng(seed)), got "
             f"{type(rng).__name__}"
         )
-    width = _int_at_least("width", width, 360)
-    height = _int_at_least("height", height, 90)
+    width = int_at_least("width", width, 360)
+    height = int_at_least("height", height, 90)
     if kind not in PANORAMA_KINDS:
         raise ValueError(f"kind must be one of {PANORAMA_KINDS}, got {kind!r}")
-    sigma = _finite("noise", noise)
-    if sigma < 0.0:
-        raise ValueError(f"noise must be >= 0, got {noise!r}")
+    sigma = nonnegative_float("noise", noise)
 
     top, bottom, azimuth0 = 45.0, -45.0, 0.0
     azimuth = np.asarray(wrap360(azimuth0 - 360.0 * (np.arange(width) + 0.5) / width))
@@ -799,7 +736,7 @@ def make_panorama(
     else:
         _draw_outdoor(rng, canvas)
     img = canvas.img
-    img *= (1.0 + 0.05 * _noise_2d(rng, width, height, 36, 9))[:, :, None]  # soft lighting
+    img *= (1.0 + 0.05 * value_noise(rng, height, width, 36, 9))[:, :, None]  # soft lighting
     if sigma > 0.0:
         img += rng.standard_normal(img.shape, dtype=np.float32) * np.float32(sigma)
     np.clip(img, 0.0, 255.0, out=img)

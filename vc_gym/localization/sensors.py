@@ -1,9 +1,10 @@
 """The compass and the atlas as sensor models for the filters (paper eq. 22).
 
-They satisfy the structural protocols of :mod:`vc_gym.filters.protocol` without
-importing the filters: a :class:`CompassHeadingSensor` is a heading sensor (and a
-heading-only pose sensor), an :class:`AtlasPoseSensor` a pose sensor. The observation
-of both is a camera image.
+The adapters between the two layers below: they satisfy the structural protocols of
+:mod:`vc_gym.filters.protocol`, so the filters never import the compass and the
+compass never imports the filters. A :class:`CompassHeadingSensor` is a heading
+sensor (and a heading-only pose sensor), an :class:`AtlasPoseSensor` a pose sensor.
+The observation of both is a camera image.
 """
 
 from __future__ import annotations
@@ -12,33 +13,15 @@ import math
 
 import numpy as np
 
-from vc_gym.compass.atlas import AtlasEstimate, CompassAtlas
-from vc_gym.compass.camera import Camera
-from vc_gym.compass.visual_compass import VisualCompass
+from vc_gym.angles import interp_circular
+from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas, VisualCompass
 from vc_gym.validation import positive_float
 
 __all__ = [
     "AtlasPoseSensor",
     "CompassHeadingSensor",
     "best_spot_heading_log_likelihood",
-    "interp_circular",
 ]
-
-
-def interp_circular(values: np.ndarray, step_deg: float, query_deg: np.ndarray) -> np.ndarray:
-    """Linear interpolation of ``values`` sampled at ``0, step, 2 step, ...`` (circular).
-
-    Exact where the query falls on the grid; ``-inf`` neighbours give ``-inf``.
-    """
-    n = values.size
-    pos = np.mod(np.asarray(query_deg, dtype=np.float64), 360.0) / step_deg
-    i0 = np.floor(pos).astype(np.int64)
-    frac = pos - i0
-    a = values[i0 % n]
-    b = values[(i0 + 1) % n]
-    with np.errstate(invalid="ignore"):
-        out = np.where(frac == 0.0, a, (1.0 - frac) * a + frac * b)
-    return out
 
 
 def best_spot_heading_log_likelihood(
@@ -144,13 +127,36 @@ class AtlasPoseSensor:
         self.position_noise_m = float(position_noise_m)
         self.heading_temperature = float(heading_temperature)
 
-    def pose_log_likelihood(self, observation: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """Log-likelihood of every row ``(x, y, θ)`` of ``poses`` for one image."""
+    def pose_log_likelihood(
+        self,
+        observation: np.ndarray | AtlasEstimate,
+        poses: np.ndarray,
+        head_pan_deg: float = 0.0,
+    ) -> np.ndarray:
+        """Log-likelihood of every row ``(x, y, θ)`` of ``poses`` for one frame.
+
+        Parameters
+        ----------
+        observation : numpy.ndarray or AtlasEstimate
+            The camera image, or ``atlas.estimate_position(image, camera)`` already
+            computed for it (a tracker that needs the estimate anyway passes it, so the
+            atlas runs once per frame).
+        poses : numpy.ndarray
+            ``(N, 3)`` body poses ``x`` (m), ``y`` (m), ``θ`` (deg).
+        head_pan_deg : float
+            Head pan when the frame was taken (left positive): the camera looked at
+            ``θ + head_pan_deg``.
+        """
         p = np.asarray(poses, dtype=np.float64)
         if p.ndim != 2 or p.shape[1] != 3:
             raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
-        est = self.atlas.estimate_position(observation, self.camera)
+        if not math.isfinite(head_pan_deg):
+            raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
+        if isinstance(observation, AtlasEstimate):
+            est = observation
+        else:
+            est = self.atlas.estimate_position(observation, self.camera)
         d2 = (p[:, 0] - est.position[0]) ** 2 + (p[:, 1] - est.position[1]) ** 2
-        heading = best_spot_heading_log_likelihood(self.atlas, est, p[:, 2])
+        heading = best_spot_heading_log_likelihood(self.atlas, est, p[:, 2] + head_pan_deg)
         heading = heading / self.heading_temperature
         return heading - 0.5 * d2 / self.position_noise_m**2

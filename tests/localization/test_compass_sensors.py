@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from vc_gym.angles import wrap180
-from vc_gym.compass import Camera, CompassHeadingSensor
-from vc_gym.compass.synthetic import render_view
+from vc_gym.compass import Camera
 from vc_gym.filters.grid import HeadingGridFilter
 from vc_gym.filters.protocol import HeadingSensor, PoseSensor
+from vc_gym.localization import CompassHeadingSensor
+from vc_gym.worlds.panorama import render_view
 
 
 def turn_sequence(rng, steps=120):

@@ -1,0 +1,84 @@
+"""vc_gym/Homing-v0: the task as a learned agent sees it, built the same by every maker."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import vc_gym  # noqa: F401
+from vc_gym.envs.homing import HomingFeatures, StopAction
+
+FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0}
+
+
+def test_spaces_and_wrapper_chain():
+    env = gym.make("vc_gym/Homing-v0", **FAST)
+    assert env.observation_space.shape == (12,) and env.action_space.shape == (3,)
+    chain, w = [], env
+    while w is not w.unwrapped:
+        chain.append(type(w).__name__)
+        w = w.env
+    assert {"StopAction", "HomingFeatures", "CompassObservation"} <= set(chain)
+    obs, info = env.reset(seed=0)
+    assert env.observation_space.contains(obs) and "pose" in info
+    env.close()
+
+
+@pytest.mark.parametrize("tracker", ["grid", "particle", "kalman"])
+def test_trackers_plug_in_by_name(tracker):
+    env = gym.make("vc_gym/Homing-v0", tracker=tracker, **FAST)
+    obs, _ = env.reset(seed=1)
+    for _ in range(3):
+        obs, *_ = env.step(np.array([0.5, 0.0, 0.0], np.float32))
+    assert np.all(np.isfinite(obs))
+    assert env.get_wrapper_attr("tracker").__class__.__name__.lower().startswith(tracker)
+    env.close()
+
+
+def test_make_vec_and_sb3_make_vec_env_build_the_same_env():
+    sb3_env_util = pytest.importorskip("stable_baselines3.common.env_util")
+    a = gym.make("vc_gym/Homing-v0", **FAST)
+    obs_a, _ = a.reset(seed=5)
+    vec = gym.make_vec("vc_gym/Homing-v0", num_envs=1, vectorization_mode="sync", **FAST)
+    obs_v, _ = vec.reset(seed=5)
+    sb3 = sb3_env_util.make_vec_env("vc_gym/Homing-v0", n_envs=1, seed=5, env_kwargs=FAST)
+    obs_s = sb3.reset()
+    np.testing.assert_array_equal(obs_a, obs_v[0])
+    np.testing.assert_array_equal(obs_a, obs_s[0])
+    for e in (a, vec, sb3):
+        e.close()
+
+
+def test_features_need_compass_observations():
+    with pytest.raises(ValueError, match="CompassObservation"):
+        HomingFeatures(gym.make("CartPole-v1"))
+    with pytest.raises(ValueError, match="Box\\(5\\)"):
+        StopAction(gym.make("CartPole-v1"))
+
+
+def test_stop_action_holds_still_until_the_task_stops():
+    env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=1.0)
+    assert env.action_space.shape == (3,)
+    stop_wrapper = env
+    while not isinstance(stop_wrapper, StopAction):
+        stop_wrapper = stop_wrapper.env
+    env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
+    stop = np.array([0.0, 0.0, 1.0], np.float32)
+    turn_and_stop = np.array([0.0, 1.0, 1.0], np.float32)
+    for _ in range(stop_wrapper.min_walk_steps):  # stop requests while the filters settle: ignored
+        _, r, terminated, _, info = env.step(turn_and_stop)
+        assert not terminated and info["still_time_s"] == 0.0
+    env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
+    stop_wrapper.min_walk_steps = 0
+    obs, r, terminated, truncated, info = env.step(stop)
+    assert terminated and info["stopped"] and info["success"]
+    assert r == pytest.approx(10.0, abs=1e-3)  # the success bonus, summed over the hold
+    assert info["still_time_s"] == pytest.approx(1.0)
+    env.reset(seed=0, options={"pose": (1.0, 0.0, 180.0)})
+    _, r, terminated, _, info = env.step(np.array([1.0, 0.0, -1.0], np.float32))
+    assert not terminated and r > 0.2  # walked towards home (0.4 m/s for 0.1 s, from rest)
+    assert r == pytest.approx(10.0 * (1.0 - info["home_error_m"]), abs=1e-6)
+    with pytest.raises(ValueError):
+        env.step(np.array([np.nan, 0.0, 0.0]))
+    env.close()

@@ -1,0 +1,160 @@
+"""Every registered tracker, on a walk through the ray-cast room with known poses."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vc_gym.angles import wrap180
+from vc_gym.compass import Camera
+from vc_gym.filters import HeadingGridFilter, TranslationalFilter
+from vc_gym.localization import (
+    TRACKERS,
+    GridTracker,
+    KalmanTracker,
+    ParticleTracker,
+    Tracker,
+    TrackerState,
+    best_spot_heading_log_likelihood,
+    make_tracker,
+)
+from vc_gym.poses import compose
+from vc_gym.worlds.room import render_room_view
+
+START = (0.6, -0.4, 30.0)
+#: (forward m, turn deg) per frame: stand, turn left, walk, turn right
+MOVES = [(0.0, 0.0)] * 8 + [(0.0, 20.0)] * 4 + [(0.1, 0.0)] * 4 + [(0.0, -12.0)] * 4
+
+
+def walk(room):
+    """Frames, odometry and true poses of MOVES from START (exact odometry)."""
+    pose = START
+    frames = [(render_room_view(room, *pose[:2], Camera(yaw_deg=pose[2])), (0.0, 0.0, 0.0), pose)]
+    for fwd, turn in MOVES:
+        pose = compose(pose, (fwd, 0.0, turn))
+        frames.append(
+            (render_room_view(room, *pose[:2], Camera(yaw_deg=pose[2])), (fwd, 0.0, turn), pose)
+        )
+    return frames
+
+
+@pytest.fixture(scope="module")
+def frames(synthetic_room):
+    return walk(synthetic_room)
+
+
+def run(tracker, atlas, frames):
+    tracker.reset(atlas, Camera(), 0.1)
+    return [tracker.update(img, 0.0, odo) for img, odo, _ in frames]
+
+
+@pytest.mark.parametrize("name", sorted(TRACKERS))
+def test_tracker_follows_the_walk(name, room_atlas, frames):
+    tracker = make_tracker(name)
+    assert isinstance(tracker, Tracker)
+    states = run(tracker, room_atlas, frames)
+    last, (_, _, true) = states[-1], frames[-1]
+    assert isinstance(last, TrackerState)
+    assert abs(wrap180(last.heading_deg - true[2])) < 10.0
+    assert 0.0 < last.heading_spread_deg < 30.0
+    assert last.belief.sum() == pytest.approx(1.0) and np.all(last.belief >= 0)
+    peak = 360.0 * np.argmax(last.belief) / last.belief.size
+    assert abs(wrap180(peak - true[2])) < 15.0
+    assert last.goodness.shape == (4,) and np.all(last.goodness > 0)
+    assert all(math.isfinite(v) and v >= 0 for v in last.position_std_m)
+    # the atlas position is coarse (paper 5.2: ~0.3 m)
+    x, y = last.position
+    assert math.hypot(x - true[0], y - true[1]) < 0.6
+
+
+def test_grid_tracker_is_the_papers_two_filters(room_atlas, frames):
+    """GridTracker = heading grid filter (mixing, eq. 24) + translational filter (eq. 32),
+    composed by hand here exactly as the paper describes them."""
+    states = run(GridTracker(), room_atlas, frames)
+    hf = HeadingGridFilter(1.0, rule="mixing", half_life_s=0.3, dt_s=0.1)
+    tf = TranslationalFilter(room_atlas.positions, 0.3, 0.1)
+    for (img, (fwd, left, turn), _), state in zip(frames, states, strict=True):
+        hf.predict(turn, noise_deg=0.5 + 0.1 * abs(turn))
+        est = room_atlas.estimate_position(img, Camera())
+        hf.update_log_likelihood(best_spot_heading_log_likelihood(room_atlas, est, hf.headings_deg))
+        h = hf.estimate().heading_deg
+        th = math.radians(h)
+        tf.predict(
+            fwd * math.cos(th) - left * math.sin(th), fwd * math.sin(th) + left * math.cos(th)
+        )
+        tf.update_position(est.position)
+        assert state.heading_deg == h
+        assert state.position == tf.position
+        np.testing.assert_array_equal(state.belief, hf.belief)
+
+
+def test_particle_tracker_is_reproducible_and_recovers(room_atlas, frames):
+    a = run(ParticleTracker(n_particles=500, seed=3), room_atlas, frames)
+    b = run(ParticleTracker(n_particles=500, seed=3), room_atlas, frames)
+    assert [s.position for s in a] == [s.position for s in b]
+    # started uniform over the field: wide at first, narrower once the frames agree
+    assert max(a[0].position_std_m) > 0.8
+    assert max(a[-1].position_std_m) < max(a[0].position_std_m)
+
+
+def test_particle_bounds_default_to_the_spots_grown(room_atlas):
+    t = ParticleTracker(margin_m=2.0)
+    assert t.field_bounds(room_atlas) == pytest.approx((-3.0, 3.001, -3.0, 3.001))
+    assert ParticleTracker(bounds=(-1, 1, -2, 2)).field_bounds(room_atlas) == (-1, 1, -2, 2)
+
+
+def test_kalman_tracker_rejects_then_relocks(room_atlas, frames):
+    t = KalmanTracker(max_rejections=2)
+    t.reset(room_atlas, Camera(), 0.1)
+    t.heading_filter.reset(START[2] + 120.0, 3.0)  # confidently wrong
+    img, _, _ = frames[0]
+    t.update(img, 0.0, (0.0, 0.0, 0.0))
+    assert t.rejections == 1  # the frame disagrees by 120 deg: rejected
+    state = t.update(img, 0.0, (0.0, 0.0, 0.0))
+    assert abs(wrap180(state.heading_deg - START[2])) < 10.0  # second rejection: restart on it
+
+
+@pytest.mark.parametrize("name", sorted(TRACKERS))
+def test_bad_use_is_a_clear_error(name, room_atlas, frames):
+    t = make_tracker(name)
+    img = frames[0][0]
+    with pytest.raises(RuntimeError, match="reset"):
+        t.update(img, 0.0, (0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="CompassAtlas"):
+        t.reset("atlas.npz", Camera(), 0.1)
+    with pytest.raises(ValueError, match="Camera"):
+        t.reset(room_atlas, None, 0.1)
+    with pytest.raises(ValueError, match="dt_s"):
+        t.reset(room_atlas, Camera(), 0.0)
+    t.reset(room_atlas, Camera(), 0.1)
+    with pytest.raises(ValueError, match="odometry"):
+        t.update(img, 0.0, (0.0, np.nan, 0.0))
+    with pytest.raises(ValueError, match="odometry"):
+        t.update(img, 0.0, (0.0, 0.0))
+    with pytest.raises(ValueError, match="head_pan_deg"):
+        t.update(img, np.inf, (0.0, 0.0, 0.0))
+    with pytest.raises(ValueError):
+        t.update(img[:, :, 0], 0.0, (0.0, 0.0, 0.0))
+
+
+@pytest.mark.parametrize(
+    ("cls", "kwargs"),
+    [
+        (GridTracker, {"half_life_s": 0.0}),
+        (GridTracker, {"rule": "vote"}),
+        (GridTracker, {"turn_noise": -1.0}),
+        (KalmanTracker, {"gate_sigma": float("nan")}),
+        (KalmanTracker, {"max_rejections": 0}),
+        (KalmanTracker, {"heading_temperature": "hot"}),
+        (ParticleTracker, {"n_particles": 0}),
+        (ParticleTracker, {"outlier": 1.0}),
+        (ParticleTracker, {"bounds": (1, 0, 0, 1)}),
+        (ParticleTracker, {"motion_noise": (0.1, -0.1, 1.0)}),
+        (ParticleTracker, {"seed": 1.5}),
+    ],
+)
+def test_bad_parameters(cls, kwargs):
+    with pytest.raises(ValueError):
+        cls(**kwargs)

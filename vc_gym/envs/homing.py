@@ -1,0 +1,150 @@
+"""``vc_gym/Homing-v0``: the homing task as a learned agent sees it.
+
+``vc_gym/LearnThenHome-v0`` → :class:`~vc_gym.envs.CompassObservation` (image
+dropped, any tracker) → :class:`HomingFeatures` (one scaled feature vector) →
+:class:`StopAction` (walk, turn, stop). ``gym.make("vc_gym/Homing-v0", **kwargs)``,
+``gym.make_vec`` and stable-baselines3's ``make_vec_env`` all build exactly what
+``vc-gym train`` trains on.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from vc_gym.envs.compass_observation import CompassObservation
+from vc_gym.envs.learning import LearningConfig
+from vc_gym.localization import TrackerSpec
+from vc_gym.validation import nonnegative_float, positive_float
+
+__all__ = ["STOP_THRESHOLD", "HomingFeatures", "StopAction", "make_homing_env"]
+
+STOP_THRESHOLD = 0.5
+
+
+class HomingFeatures(gym.ObservationWrapper):
+    """The compass outputs of :class:`~vc_gym.envs.CompassObservation` as one vector.
+
+    ``[home_vector / 2 m (2), cos θ̂, sin θ̂, heading spread / 180°, position / 2 m (2),
+    log goodness / 5 (one per spot, clipped to ±5), head pan / 90°]``: all of order 1.
+    """
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        space = env.observation_space
+        needed = {"home_vector", "heading", "heading_spread", "position", "goodness", "head"}
+        if not isinstance(space, spaces.Dict) or not needed <= set(space.spaces):
+            raise ValueError(f"HomingFeatures needs a CompassObservation env, got {space}")
+        self.n_spots = space["goodness"].shape[0]
+        n = 8 + self.n_spots
+        self.observation_space = spaces.Box(-10.0, 10.0, (n,), np.float32)
+
+    def observation(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        g = np.log(np.maximum(obs["goodness"].astype(np.float64), 1e-12)) / 5.0
+        f = np.concatenate(
+            [
+                obs["home_vector"] / 2.0,
+                obs["heading"],
+                obs["heading_spread"] / 180.0,
+                obs["position"] / 2.0,
+                np.clip(g, -5.0, 5.0),
+                obs["head"][:1] / 90.0,
+            ]
+        )
+        return np.clip(f, -10.0, 10.0).astype(np.float32)
+
+
+class StopAction(gym.Wrapper):
+    """``Box(-1, 1, (3,))`` actions: walk (> 0 forward), turn, stop (> 0.5).
+
+    Walking maps ``max(a[0], 0)`` to ``max_forward`` m/s, turning ``a[1]`` to
+    ``max_turn_deg_s`` (left positive), through the task env's ``velocity_action``.
+    ``a[2] > 0.5`` makes the robot stand still, scanning with its head, until the
+    wrapped task ends the episode (it stops after ``stop_time_s``); the rewards of
+    those steps are summed into one. Holding a Gaussian policy's motion outputs near
+    zero for 50 steps in a row is all but impossible to learn by chance; one stop
+    decision is easy. Stop requests in the first ``min_walk_s`` of an episode are
+    ignored (the filters are still settling, and an untrained policy would otherwise
+    end most episodes within a step or two).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        max_forward: float = 0.4,
+        max_turn_deg_s: float = 60.0,
+        min_walk_s: float = 2.0,
+    ):
+        super().__init__(env)
+        inner = env.action_space
+        if not isinstance(inner, spaces.Box) or inner.shape[0] < 5:
+            raise ValueError(f"StopAction needs the task's Box(5) actions, got {inner}")
+        if not hasattr(env.unwrapped, "velocity_action"):
+            raise ValueError("StopAction wraps vc_gym/LearnThenHome-v0 (its velocity_action)")
+        self.max_forward = positive_float("max_forward", max_forward)
+        self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
+        nonnegative_float("min_walk_s", min_walk_s)
+        self._pans = LearningConfig().head_scan_deg
+        self._n = inner.shape[0]
+        self.action_space = spaces.Box(-1.0, 1.0, (3,), np.float32)
+        self._max_hold = 10**5
+        self.min_walk_steps = int(round(min_walk_s / env.unwrapped.control_dt))
+        self._t = 0
+
+    def reset(self, **kwargs):
+        self._t = 0
+        return self.env.reset(**kwargs)
+
+    def _inner_action(self, forward: float, turn: float, pan_deg: float = 0.0) -> np.ndarray:
+        a = np.zeros(self._n, np.float32)
+        a[:5] = self.env.unwrapped.velocity_action(
+            forward_m_s=forward * self.max_forward,
+            turn_deg_s=turn * self.max_turn_deg_s,
+            pan_deg=pan_deg,
+        )
+        return a
+
+    def step(self, action):
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (3,) or not np.all(np.isfinite(a)):
+            raise ValueError(f"action must be 3 finite numbers, got {action!r}")
+        a = np.clip(a, -1.0, 1.0)
+        self._t += 1
+        if a[2] <= STOP_THRESHOLD or self._t <= self.min_walk_steps:
+            return self.env.step(self._inner_action(max(a[0], 0.0), a[1]))
+        total = 0.0
+        for i in range(self._max_hold):
+            pan = self._pans[i % len(self._pans)]
+            obs, r, terminated, truncated, info = self.env.step(self._inner_action(0.0, 0.0, pan))
+            total += float(r)
+            if terminated or truncated:
+                break
+        return obs, total, terminated, truncated, info
+
+
+def make_homing_env(
+    tracker: TrackerSpec = "grid",
+    max_forward: float = 0.4,
+    max_turn_deg_s: float = 60.0,
+    min_walk_s: float = 2.0,
+    **task_kwargs: Any,
+) -> gym.Env:
+    """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
+
+    Parameters
+    ----------
+    tracker : str, dict or callable
+        The tracker of the :class:`~vc_gym.envs.CompassObservation` wrapper.
+    max_forward, max_turn_deg_s, min_walk_s : float
+        :class:`StopAction` settings.
+    **task_kwargs
+        Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
+        ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
+    """
+    env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
+    env = CompassObservation(env, keep_image=False, tracker=tracker)
+    env = HomingFeatures(env)
+    return StopAction(env, max_forward, max_turn_deg_s, min_walk_s)

@@ -1,0 +1,319 @@
+"""The learning phase of the learn-then-home task: the paper's scripted behaviour (4.3, 5.2).
+
+The robot stands at home (the field's kickoff circle), turns a full circle there
+(colour classes, home map, odometry turn calibration by loop closure), learns the
+panorama at four spots 1 m around home (a full turn in 8 steps of 45°, each direction
+for ``learn_time_s`` with head scanning), walks back home and normalises the spots'
+goodness there. It uses camera frames, head angles and odometry only; the true pose is
+recorded for plots, never used.
+
+The task env calls a *learner*: any callable ``learner(room, config) -> LearningResult``
+(default :class:`ScriptedLearning`), so tests and users can bring their own.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from vc_gym.angles import interp_circular, wrap180, wrap360
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
+from vc_gym.filters import HeadingGridFilter
+from vc_gym.poses import compose
+from vc_gym.validation import positive_float
+
+__all__ = [
+    "HOME",
+    "SPOT_NAMES",
+    "Learner",
+    "LearningConfig",
+    "LearningResult",
+    "RobotFell",
+    "ScriptedLearner",
+    "ScriptedLearning",
+    "kidnap_pose",
+]
+
+#: Home of the task: the world origin (robolab: the centre of the kickoff circle).
+HOME = (0.0, 0.0)
+SPOT_NAMES = ("east", "north", "west", "south")
+
+
+class RobotFell(Exception):
+    """The robot fell during the learning phase."""
+
+
+@dataclass(frozen=True)
+class LearningConfig:
+    """Parameters of the scripted learning phase (paper values as defaults).
+
+    Parameters
+    ----------
+    spot_distance_m : float
+        Distance of the four training spots from home (paper: 1 m).
+    learn_time_s : float
+        Learning time per direction (paper 4.3: 5 s).
+    head_scan_deg : tuple of float
+        Head pans cycled while learning a direction.
+    normalise_directions : int
+        Directions at home whose frames normalise the goodness (paper 5.2).
+    half_life_s : float
+        Mixing half-life of the heading filter that keeps the robot's heading on the
+        home map while it walks between spots (paper 4.2: 0.3 s).
+    compass : CompassConfig
+        Compass parameters of every map.
+    """
+
+    spot_distance_m: float = 1.0
+    learn_time_s: float = 5.0
+    head_scan_deg: tuple[float, ...] = (-40.0, -20.0, 0.0, 20.0, 40.0, 20.0, 0.0, -20.0)
+    normalise_directions: int = 12
+    half_life_s: float = 0.3
+    compass: CompassConfig = field(default_factory=CompassConfig)
+
+    def __post_init__(self) -> None:
+        for name in ("spot_distance_m", "learn_time_s", "half_life_s"):
+            positive_float(name, getattr(self, name))
+        if not self.head_scan_deg or any(abs(p) > 90 for p in self.head_scan_deg):
+            raise ValueError(
+                f"head_scan_deg must be non-empty pans within ±90°, got {self.head_scan_deg}"
+            )
+        n = self.normalise_directions
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"normalise_directions must be an int >= 1, got {n!r}")
+        if not isinstance(self.compass, CompassConfig):
+            raise ValueError(f"compass must be a CompassConfig, got {type(self.compass).__name__}")
+
+
+@dataclass
+class LearningResult:
+    """What a learning phase produced.
+
+    Attributes
+    ----------
+    atlas : CompassAtlas
+        The learned, normalised atlas (home at :data:`HOME`).
+    spots : dict
+        Where the robot meant to learn each spot (world metres).
+    true_path : list of tuple
+        True ``(x, y, yaw)`` of every spot-learning frame (for plots only).
+    odometry_turn_scale : float
+        The loop-closure correction of the odometry's turns (1: none).
+    """
+
+    atlas: CompassAtlas
+    spots: dict[str, tuple[float, float]]
+    true_path: list[tuple[float, float, float]] = field(default_factory=list)
+    odometry_turn_scale: float = 1.0
+
+
+#: A learner: ``learner(room, config) -> LearningResult``. ``room`` is a
+#: ``vc_gym/AiboRoom-v0`` env just reset with the robot at home facing 0°.
+Learner = Callable[..., LearningResult]
+
+
+class ScriptedLearner:
+    """The paper's learning behaviour on a ``vc_gym/AiboRoom-v0`` env (4.3, 5.2).
+
+    The robot must stand at home facing the world's 0° (its frame is then the world
+    frame). :meth:`learn` turns a full circle there (colour classes, home map, odometry
+    turn calibration by loop closure), learns four spots ``spot_distance_m`` around
+    home (8 × 45°, ``learn_time_s`` each, head scanning), walks back and normalises the
+    spots' goodness at home.
+
+    Parameters
+    ----------
+    room : AiboRoomEnv
+        The room env (unwrapped), with the default head camera.
+    config : LearningConfig, optional
+        Behaviour parameters.
+    progress : bool
+        Show a progress bar while learning the spots.
+    """
+
+    def __init__(self, room, config: LearningConfig | None = None, progress: bool = False):
+        self.room = room
+        self.config = config if config is not None else LearningConfig()
+        self.progress = progress
+        self.dt = room.control_dt
+        self.camera = Camera(hfov_deg=room.camera.hfov_deg)
+        self._scan_i = 0
+        # the robot's belief about its pose during learning (odometry + compass)
+        self.belief = np.zeros(3)
+        self.rot_scale = 1.0  # odometry turn calibration, from the loop closure at home
+        self.turn_accum = 0.0
+        self.home_compass: VisualCompass | None = None
+        self.learn_filter: HeadingGridFilter | None = None
+        self.obs: dict | None = None
+        self.info: dict | None = None
+
+    def _act(self, forward: float = 0.0, turn: float = 0.0, pan: float = 0.0) -> None:
+        action = self.room.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
+        self.obs, _, terminated, _, self.info = self.room.step(action)
+        dx, dy, dth = (float(v) for v in self.obs["odometry"])
+        dth *= self.rot_scale
+        self.turn_accum += dth
+        x, y, th = compose(tuple(self.belief), (dx, dy, dth))
+        self.belief = np.array([x, y, th])
+        if terminated:
+            raise RobotFell()
+        if self.learn_filter is not None and self.home_compass is not None:
+            # keep the heading belief on the home map while learning elsewhere
+            f = self.learn_filter
+            f.predict(dth, noise_deg=0.3 + 0.05 * abs(dth))
+            pan = float(self.obs["head"][0])
+            ll = self.home_compass.log_likelihood(self.obs["image"], self.camera)
+            step = self.home_compass.config.heading_step_deg
+            f.update_log_likelihood(interp_circular(ll, step, f.headings_deg + pan))
+            self.belief[2] = f.estimate().heading_deg
+
+    def _next_pan(self) -> float:
+        pans = self.config.head_scan_deg
+        self._scan_i = (self._scan_i + 1) % len(pans)
+        return pans[self._scan_i]
+
+    def _turn_to(self, yaw_deg: float, pan: float = 0.0, tol: float = 2.0) -> None:
+        for _ in range(200):
+            err = float(wrap180(yaw_deg - self.belief[2]))
+            if abs(err) < tol:
+                return
+            self._act(turn=float(np.clip(3.0 * err, -80.0, 80.0)), pan=pan)
+
+    def _walk_to(self, x: float, y: float, tol: float = 0.05) -> None:
+        for _ in range(400):
+            dx, dy = x - self.belief[0], y - self.belief[1]
+            dist = math.hypot(dx, dy)
+            if dist < tol:
+                return
+            bearing = math.degrees(math.atan2(dy, dx))
+            err = float(wrap180(bearing - self.belief[2]))
+            if abs(err) > 20:
+                self._turn_to(bearing)
+                continue
+            self._act(forward=min(0.3, 1.5 * dist), turn=float(np.clip(3.0 * err, -60, 60)))
+
+    def spots(self) -> dict[str, tuple[float, float]]:
+        """The four training spots around home (world metres)."""
+        d = self.config.spot_distance_m
+        return {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
+
+    def learn(self) -> LearningResult:
+        """Learning phase: home turn, four spots, normalisation at home.
+
+        Raises
+        ------
+        RobotFell
+            If the robot falls (only with ``locomotion="dynamic"``).
+        """
+        cfg = self.config
+        self.belief = np.zeros(3)
+        self.learn_filter = None
+        steps = max(1, int(round(cfg.learn_time_s / self.dt)))
+        spots = self.spots()
+        path: list[tuple[float, float, float]] = []
+        self._learn_home(steps)
+        colors = self.home_compass.colors
+        compasses = {}
+        bar = tqdm(
+            total=4 * 8 * steps, desc="learn 4 spots", unit="frame", disable=not self.progress
+        )
+        for name in SPOT_NAMES:
+            self._walk_to(*spots[name])
+            vc = VisualCompass(cfg.compass, colors)
+            for k in range(8):
+                self._turn_to(45.0 * k)
+                for _ in range(steps):
+                    self._act(pan=self._next_pan())
+                    pan = float(self.obs["head"][0])
+                    vc.learn(self.obs["image"], self.camera.replace(yaw_deg=self.belief[2] + pan))
+                    path.append(tuple(float(v) for v in self.info["pose"]))
+                    bar.update()
+            compasses[name] = (spots[name], vc)
+        bar.close()
+        self._walk_to(*HOME)
+        atlas = CompassAtlas(compasses, home="home", home_position=HOME)
+        imgs, cams = [], []
+        for k in range(cfg.normalise_directions):
+            self._turn_to(360.0 * k / cfg.normalise_directions)
+            self._act()
+            imgs.append(self.obs["image"])
+            cams.append(self.camera)
+        atlas.normalize(imgs, cams)
+        return LearningResult(atlas, spots, path, self.rot_scale)
+
+    def _learn_home(self, steps: int) -> None:
+        """Learn the home map in a full turn and calibrate the odometry's turns.
+
+        The robot turns a full circle in 8 steps of 45°, scanning with its head, and
+        keeps the frames. Its colour classes are fitted on them (the paper calibrated
+        colours beforehand). Loop closure: a map of the first direction tells how far
+        the robot really turned when its odometry says 360°; that scale corrects the
+        odometry from then on and the headings of every frame of the turn, which are
+        then learned as the home map (odometry drift taken as proportional to the turn).
+        """
+        cfg = self.config
+        self.turn_accum = 0.0
+        start = float(self.belief[2])
+        frames = []  # (image, believed body turn since the start, head pan, direction)
+        for k in range(8):
+            self._turn_to(start + 45.0 * k)
+            for _ in range(steps):
+                self._act(pan=self._next_pan())
+                frames.append((self.obs["image"], self.turn_accum, float(self.obs["head"][0]), k))
+        self._turn_to(start)
+        for _ in range(3):
+            self._act()
+        per_direction = {}
+        for image, _, _, k in frames:
+            per_direction.setdefault(k, image)
+        colors = VisualCompass(cfg.compass).fit_colors(list(per_direction.values())).colors
+        first = VisualCompass(cfg.compass, colors)
+        for image, turn, pan, k in frames:
+            if k == 0:
+                first.learn(image, self.camera.replace(yaw_deg=start + turn + pan))
+        believed = self.turn_accum  # about 360
+        measured = first.estimate(self.obs["image"], self.camera).heading_deg
+        actual = believed + float(wrap180(measured - (start + believed)))
+        if believed > 180.0:
+            self.rot_scale = float(np.clip(actual / believed, 0.8, 1.25))
+        home = VisualCompass(cfg.compass, colors)
+        for image, turn, pan, _ in frames:
+            home.learn(image, self.camera.replace(yaw_deg=start + turn * self.rot_scale + pan))
+        self.home_compass = home
+        self.belief[2] = wrap360(start + actual)
+        self.learn_filter = HeadingGridFilter(
+            rule="mixing", half_life_s=cfg.half_life_s, dt_s=self.dt
+        )
+        self.learn_filter.reset(self.belief[2], 2.0)
+
+
+class ScriptedLearning:
+    """The default learner of the task env: runs :class:`ScriptedLearner`.
+
+    Parameters
+    ----------
+    progress : bool
+        Show a progress bar while the spots are learned.
+    """
+
+    def __init__(self, progress: bool = False):
+        self.progress = bool(progress)
+
+    def __call__(self, room, config: LearningConfig) -> LearningResult:
+        return ScriptedLearner(room, config, progress=self.progress).learn()
+
+
+def kidnap_pose(
+    rng: np.random.Generator, field_bounds: tuple[float, float, float, float], margin: float = 0.5
+) -> tuple[float, float, float]:
+    """A random pose on the field, ``margin`` metres inside its edges, random heading."""
+    fx0, fx1, fy0, fy1 = field_bounds
+    return (
+        float(rng.uniform(fx0 + margin, fx1 - margin)),
+        float(rng.uniform(fy0 + margin, fy1 - margin)),
+        float(rng.uniform(0.0, 360.0)),
+    )

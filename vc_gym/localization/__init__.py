@@ -1,0 +1,52 @@
+"""What the robot knows: trackers that fuse the compass and odometry into a pose belief.
+
+This layer joins the two below it: the compass (:mod:`vc_gym.compass`) and the
+filters (:mod:`vc_gym.filters`) never import each other; the adapters
+(:class:`CompassHeadingSensor`, :class:`AtlasPoseSensor`) and the trackers live here.
+
+Every tracker satisfies :class:`Tracker`: ``reset(atlas, camera, dt_s)`` and
+``update(image, head_pan_deg, odometry) -> TrackerState``.
+
+* :class:`GridTracker` -- the paper's heading grid filter (eq. 23-27) and
+  translational filter (eq. 30-32);
+* :class:`ParticleTracker` -- particles over ``(x, y, θ)`` weighted by the atlas and
+  the compass, with injection so a kidnapping is recovered;
+* :class:`KalmanTracker` -- an unscented Kalman heading filter and the translational
+  filter.
+
+:func:`make_tracker` builds one from a name, a ``{"type": name, **kwargs}`` dict or a
+callable; :func:`register_tracker` adds a name.
+
+>>> from vc_gym.localization import make_tracker          # doctest: +SKIP
+>>> tracker = make_tracker({"type": "particle", "n_particles": 2000})   # doctest: +SKIP
+>>> tracker.reset(atlas, camera, dt_s=0.1)                 # doctest: +SKIP
+>>> state = tracker.update(image, head_pan_deg=20.0, odometry=(0.02, 0.0, 1.5))  # doctest: +SKIP
+"""
+
+from vc_gym.localization.grid import GridTracker
+from vc_gym.localization.kalman import KalmanTracker
+from vc_gym.localization.particle import ParticleTracker
+from vc_gym.localization.position import AtlasPositionFilter
+from vc_gym.localization.protocol import Tracker, TrackerState
+from vc_gym.localization.registry import TRACKERS, TrackerSpec, make_tracker, register_tracker
+from vc_gym.localization.sensors import (
+    AtlasPoseSensor,
+    CompassHeadingSensor,
+    best_spot_heading_log_likelihood,
+)
+
+__all__ = [
+    "TRACKERS",
+    "AtlasPoseSensor",
+    "AtlasPositionFilter",
+    "CompassHeadingSensor",
+    "GridTracker",
+    "KalmanTracker",
+    "ParticleTracker",
+    "Tracker",
+    "TrackerSpec",
+    "TrackerState",
+    "best_spot_heading_log_likelihood",
+    "make_tracker",
+    "register_tracker",
+]
