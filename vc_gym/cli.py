@@ -126,6 +126,19 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                 f"2 async envs: x{result['async2_speedup']:.2f}, "
                 f"2 sync envs: x{result['sync2_speedup']:.2f}"
             )
+    elif args.what == "trackers":
+        from vc_gym.experiments.bench_trackers import bench_trackers
+
+        result = bench_trackers(repeats=max(1, args.repeats // 3), seed=args.seed)
+        if not args.json:
+            print(f"{'atlas alone':12s} {result['atlas_ms']:7.3f} ms per frame (shared by all)")
+            for name, v in result["trackers"].items():
+                print(
+                    f"{name:12s} {v['update_ms']:7.3f} ms per update "
+                    f"(+{v['overhead_ms']:.3f} ms over the atlas); final heading error "
+                    f"{v['final_heading_error_deg']:.1f}°, position error "
+                    f"{v['final_position_error_m'] * 100:.0f} cm"
+                )
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:
@@ -287,11 +300,15 @@ def build_parser() -> argparse.ArgumentParser:
             "one update of every filter (1 deg grid, 1,000 and 10,000 particles, Kalman) and "
             "their heading errors on one seeded tracking run with the real compass. env: steps per "
             "second of vc_gym/AiboRoom-v0 next to bare PyBullet doing the same physics and "
-            "render, and the speed-up of 2 async envs. The last line of --json output is one "
-            "JSON object."
+            "render, and the speed-up of 2 async envs. trackers: cost of one update of every "
+            "registered tracker (grid, particle, kalman) on the same walk through a ray-cast "
+            "room with a 4-spot atlas, next to the atlas alone. The last line of --json output "
+            "is one JSON object."
         ),
     )
-    p.add_argument("what", choices=["compass", "filters", "env"], help="what to benchmark")
+    p.add_argument(
+        "what", choices=["compass", "filters", "env", "trackers"], help="what to benchmark"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
     p.add_argument("--frames", type=int, default=40, help="compass: distinct test frames")

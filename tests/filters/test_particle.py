@@ -420,3 +420,23 @@ def test_call_validation():
         pf.reset(std=(0.1, 0.1, 1.0))
     with pytest.raises(ValueError, match="rng"):
         pf.reset((0.0, 0.0, 0.0), rng=np.random.RandomState(0))
+
+
+def test_replace_overwrites_chosen_particles_only():
+    pf = ParticleFilter(10, bounds=(-1, 1, -1, 1), rng=np.random.default_rng(0))
+    before, w = pf.particles, pf.weights
+    pf.replace(np.array([2, 5]), np.array([[0.5, 0.5, 370.0], [-0.5, 0.0, -10.0]]))
+    after = pf.particles
+    np.testing.assert_allclose(after[[2, 5]], [[0.5, 0.5, 10.0], [-0.5, 0.0, 350.0]])
+    keep = np.setdiff1d(np.arange(10), [2, 5])
+    np.testing.assert_array_equal(after[keep], before[keep])
+    np.testing.assert_array_equal(pf.weights, w)
+    for idx, poses in (
+        (np.array([10]), np.zeros((1, 3))),
+        (np.array([1, 1]), np.zeros((2, 3))),
+        (np.array([0.5]), np.zeros((1, 3))),
+        (np.array([0]), np.zeros((2, 3))),
+        (np.array([0]), np.array([[np.nan, 0, 0]])),
+    ):
+        with pytest.raises(ValueError):
+            pf.replace(idx, poses)

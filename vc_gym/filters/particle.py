@@ -433,6 +433,32 @@ class ParticleFilter:
             replace = self._rng.choice(self._n, size=k, replace=False)
             self._particles[replace] = self._uniform_poses(k)
 
+    def replace(self, indices: np.ndarray, poses: np.ndarray) -> None:
+        """Overwrite the particles at ``indices`` with ``poses``; weights are unchanged.
+
+        For trackers that inject particles drawn from a sensor ("sensor resetting",
+        Lenser & Veloso 2000) instead of uniformly. Headings are wrapped to ``[0, 360)``.
+
+        Raises
+        ------
+        ValueError
+            Indices out of range or repeated, or poses that are not a finite
+            ``(len(indices), 3)`` array.
+        """
+        idx = np.asarray(indices)
+        if idx.ndim != 1 or idx.dtype.kind not in "iu":
+            raise ValueError(f"indices must be a 1-d integer array, got {indices!r}")
+        if idx.size and (idx.min() < 0 or idx.max() >= self._n):
+            raise ValueError(f"indices must lie in [0, {self._n}), got {idx.min()}..{idx.max()}")
+        if np.unique(idx).size != idx.size:
+            raise ValueError("indices must not repeat")
+        p = np.asarray(poses, dtype=np.float64)
+        if p.shape != (idx.size, 3) or not np.all(np.isfinite(p)):
+            raise ValueError(f"poses must be a finite ({idx.size}, 3) array, got shape {p.shape}")
+        p = p.copy()
+        p[:, 2] = wrap360(p[:, 2])
+        self._particles[idx] = p
+
     def estimate(self) -> PoseEstimate:
         """Weighted mean and spread of the belief.
 

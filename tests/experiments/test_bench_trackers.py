@@ -1,0 +1,21 @@
+"""`vc-gym bench trackers`: every tracker timed on the same walk, errors reported."""
+
+from __future__ import annotations
+
+import json
+
+from vc_gym.cli import main
+from vc_gym.localization import TRACKERS
+
+
+def test_bench_trackers_json(capsys, tmp_path):
+    out = tmp_path / "trackers.json"
+    assert main(["bench", "trackers", "--json", "--repeats", "3", "--out", str(out)]) == 0
+    result = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert json.loads(out.read_text()) == result
+    assert set(result["trackers"]) == set(TRACKERS)
+    assert result["atlas_ms"] > 0
+    for v in result["trackers"].values():
+        assert v["update_ms"] > 0
+        assert v["final_heading_error_deg"] < 15.0  # a walk towards home in a known room
+        assert v["final_position_error_m"] < 0.8

@@ -1,0 +1,46 @@
+"""One episode path: the demo is the first episode of the evaluation, record for record."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vc_gym.experiments.demo import run_demo
+from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
+from vc_gym.experiments.evaluate import evaluate_agent
+
+SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
+
+
+def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
+    demo = run_demo(tmp_path, seed=2, progress=False, **SHORT)
+    evaluation = evaluate_agent(episodes=1, seed=2, workers=1, progress=False, **SHORT)
+    episode = evaluation["per_episode"][0]
+    assert episode["seed"] == 3 and demo["learning_seed"] == 2
+    assert {k: demo[k] for k in episode} == episode
+    assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("tracker", ["grid", "particle"])
+def test_record_holds_what_the_plots_need(tracker):
+    run = make_homing_run(tracker=tracker, **SHORT)
+    try:
+        run.env.reset(seed=0)
+        record = run_episode(run, seed=5, options={"pose": (1.2, -0.6, 45.0)})
+    finally:
+        run.close()
+    assert isinstance(record, EpisodeRecord)
+    n = record.decisions
+    assert len(record.true) == len(record.estimated) == len(record.heading_error) == n > 0
+    assert record.start_pose == pytest.approx((1.2, -0.6, 45.0), abs=1e-6)
+    true, est = np.array(record.true), np.array(record.estimated)
+    wrapped = (est[:, 2] - true[:, 2] + 180.0) % 360.0 - 180.0
+    np.testing.assert_allclose(np.clip(wrapped, -180, 179.999), record.heading_error, atol=1e-6)
+    assert record.stopped or record.timed_out
+    assert record.stop_error_m == pytest.approx(math.hypot(*record.stop_position))
+    assert record.tracker_updates == n and record.tracker_time_s > 0
+    s = record.summary()
+    assert s["decisions"] == n and s["home_error_m"] == record.stop_error_m
+    assert "tracker_time_s" not in s  # figures only, no timings
