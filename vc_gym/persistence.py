@@ -28,15 +28,23 @@ __all__ = [
 ]
 
 
+def _umask_mode() -> int:
+    """``0o666`` minus the process umask: what ``open()`` would have given the file."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_atomic(
-    path: str | os.PathLike, write: Callable[[str], object], mode: int = 0o644
+    path: str | os.PathLike, write: Callable[[str], object], mode: int | None = None
 ) -> Path:
     """Create ``path`` whole or not at all: ``write(tmp)`` fills a temporary file in the
     same folder, which is then renamed over ``path``.
 
     A crash or an exception inside ``write`` leaves any previous file at ``path``
-    untouched and no temporary file behind. The file gets permissions ``mode``
-    (``mkstemp`` would make it private; results and models are meant to be shared).
+    untouched and no temporary file behind. The file gets permissions ``mode``, by
+    default those a plain ``open()`` would give under the process umask (``mkstemp``
+    alone would make every map, model and result private).
 
     Parameters
     ----------
@@ -44,8 +52,8 @@ def write_atomic(
         The file to create or replace; its folder must exist.
     write : callable
         ``write(tmp_path)`` writes the content to ``tmp_path`` (a str).
-    mode : int
-        Permission bits of the result.
+    mode : int, optional
+        Permission bits of the result (default: ``0o666`` minus the umask).
 
     Returns
     -------
@@ -58,7 +66,7 @@ def write_atomic(
     os.close(fd)
     try:
         write(tmp)
-        os.chmod(tmp, mode)
+        os.chmod(tmp, _umask_mode() if mode is None else mode)
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -111,9 +119,9 @@ def save_npz_atomic(
             raise ValueError(f"array {k!r} has dtype {a.dtype}; only numeric/unicode are saved")
     folder = path.parent if str(path.parent) else Path(".")
     folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as fh:
+
+    def write(tmp: str) -> None:
+        with open(tmp, "wb") as fh:
             np.savez_compressed(
                 fh,
                 schema=np.array(schema),
@@ -122,14 +130,8 @@ def save_npz_atomic(
             )
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-    return path
+
+    return write_atomic(path, write)
 
 
 def load_npz_checked(path: str | os.PathLike, schema: str, version: int) -> dict[str, np.ndarray]:

@@ -17,6 +17,7 @@ import numpy as np
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
 from vc_gym.errors import NotLearnedError
+from vc_gym.validation import positive_float
 
 __all__ = ["CompassAtlas", "AtlasEstimate"]
 
@@ -116,9 +117,7 @@ class CompassAtlas:
         if not (math.isfinite(hx) and math.isfinite(hy)):
             raise ValueError(f"home_position must be finite, got {home_position}")
         self.home_position = (hx, hy)
-        self.sharpness = float(sharpness)
-        if not math.isfinite(self.sharpness) or self.sharpness <= 0:
-            raise ValueError(f"sharpness must be finite and > 0, got {sharpness}")
+        self.sharpness = positive_float("sharpness", sharpness)
         self._home_scores = np.zeros((0, len(names)))
         self._home_headings = np.zeros((0, len(names)))
         self._kappa = 1.0

@@ -17,6 +17,7 @@ from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
 from vc_gym.envs.scenes import Scene, build_scene, check_scene_name
 from vc_gym.envs.top_view import TopView
+from vc_gym.validation import positive_float
 
 __all__ = ["AiboRoomEnv"]
 
@@ -121,8 +122,7 @@ class AiboRoomEnv(gym.Env):
             raise ValueError(f"locomotion must be one of {LOCOMOTION_MODES}, got {locomotion!r}")
         if not isinstance(randomize, bool):
             raise ValueError(f"randomize must be a bool, got {randomize!r}")
-        if not (math.isfinite(illumination) and illumination > 0):
-            raise ValueError(f"illumination must be finite and > 0, got {illumination!r}")
+        positive_float("illumination", illumination)
         if not (math.isfinite(control_dt) and 0 < control_dt <= 1.0):
             raise ValueError(f"control_dt must be in (0, 1] seconds, got {control_dt!r}")
         if light_direction is not None:

@@ -41,7 +41,7 @@ import pybullet
 import pybullet_data
 
 from vc_gym.angles import wrap360
-from vc_gym.validation import finite_float
+from vc_gym.validation import finite_float, positive_float
 
 __all__ = [
     "LOCOMOTION_MODES",
@@ -249,13 +249,6 @@ def _check_limits(name: str, limits: Sequence[float]) -> tuple[float, float]:
     return lo, hi
 
 
-def _positive(name: str, value: object) -> float:
-    v = finite_float(name, value)
-    if v <= 0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
-    return v
-
-
 def _check_obstacles(obstacles: Sequence[Sequence[float]]) -> np.ndarray:
     try:
         boxes = np.asarray(obstacles, dtype=np.float64)
@@ -365,10 +358,10 @@ class Quadruped:
         self.odometry_noise = odometry_noise
         self.physics_hz = int(physics_hz)
         self.control_hz = int(control_hz)
-        self.max_forward = _positive("max_forward", max_forward)
-        self.max_sideways = _positive("max_sideways", max_sideways)
-        self.max_turn_deg_s = _positive("max_turn_deg_s", max_turn_deg_s)
-        self.head_speed_deg_s = _positive("head_speed_deg_s", head_speed_deg_s)
+        self.max_forward = positive_float("max_forward", max_forward)
+        self.max_sideways = positive_float("max_sideways", max_sideways)
+        self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
+        self.head_speed_deg_s = positive_float("head_speed_deg_s", head_speed_deg_s)
         self.pan_limits = _check_limits("pan_limits", pan_limits)
         self.tilt_limits = _check_limits("tilt_limits", tilt_limits)
         self._rng = rng

@@ -7,7 +7,12 @@ import numpy as np
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.localization.position import AtlasPositionFilter
-from vc_gym.localization.protocol import TrackerState, check_frame_inputs, check_reset_inputs
+from vc_gym.localization.protocol import (
+    TrackerState,
+    atlas_tracker_state,
+    check_frame_inputs,
+    check_reset_inputs,
+)
 from vc_gym.localization.sensors import best_spot_heading_log_likelihood
 from vc_gym.validation import nonnegative_float, positive_float
 
@@ -73,9 +78,9 @@ class GridTracker:
         self, image: np.ndarray, head_pan_deg: float, odometry: np.ndarray | tuple
     ) -> TrackerState:
         """Motion update by ``odometry``, then sensor update by ``image``."""
-        if self.atlas is None:
-            raise RuntimeError("call reset(atlas, camera, dt_s) before update()")
-        pan, fwd, left, turn = check_frame_inputs(head_pan_deg, odometry)
+        pan, fwd, left, turn = check_frame_inputs(
+            head_pan_deg, odometry, ready=self.atlas is not None
+        )
         hf, pf = self.heading_filter, self.position_filter
         hf.predict(turn, noise_deg=self.motion_noise_deg + self.turn_noise * abs(turn))
         est = self.atlas.estimate_position(image, self.camera)
@@ -85,12 +90,12 @@ class GridTracker:
         heading = hf.estimate()
         pf.predict(fwd, left, heading.heading_deg)
         pf.update(est)
-        return TrackerState(
+        return atlas_tracker_state(
+            self.atlas,
+            est,
             heading_deg=float(heading.heading_deg),
             heading_spread_deg=float(heading.spread_deg),
             position=pf.position,
             position_std_m=pf.std_m,
-            goodness=np.array([est.goodness[n] for n in self.atlas.names]),
             belief=hf.belief,
-            atlas_position=(float(est.position[0]), float(est.position[1])),
         )

@@ -6,7 +6,12 @@ import numpy as np
 
 from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas
 from vc_gym.filters import ParticleFilter
-from vc_gym.localization.protocol import TrackerState, check_frame_inputs, check_reset_inputs
+from vc_gym.localization.protocol import (
+    TrackerState,
+    atlas_tracker_state,
+    check_frame_inputs,
+    check_reset_inputs,
+)
 from vc_gym.localization.sensors import AtlasPoseSensor, best_spot_heading_log_likelihood
 from vc_gym.validation import nonnegative_float, positive_float
 
@@ -154,9 +159,9 @@ class ParticleTracker:
         self, image: np.ndarray, head_pan_deg: float, odometry: np.ndarray | tuple
     ) -> TrackerState:
         """Motion update by ``odometry``, then sensor update by ``image``."""
-        if self.atlas is None:
-            raise RuntimeError("call reset(atlas, camera, dt_s) before update()")
-        pan, fwd, left, turn = check_frame_inputs(head_pan_deg, odometry)
+        pan, fwd, left, turn = check_frame_inputs(
+            head_pan_deg, odometry, ready=self.atlas is not None
+        )
         sf, sl, st = self.motion_noise
         pf = self.filter
         pf.predict(
@@ -175,12 +180,12 @@ class ParticleTracker:
         e = pf.estimate()
         th = pf.particles[:, 2]
         belief = np.bincount(np.floor(th).astype(np.int64) % 360, weights=pf.weights, minlength=360)
-        return TrackerState(
+        return atlas_tracker_state(
+            self.atlas,
+            est,
             heading_deg=float(e.heading_deg),
             heading_spread_deg=float(min(e.spread_deg, 180.0)),
             position=(e.x, e.y),
             position_std_m=e.std_xy,
-            goodness=np.array([est.goodness[n] for n in self.atlas.names]),
             belief=belief / belief.sum(),
-            atlas_position=(float(est.position[0]), float(est.position[1])),
         )

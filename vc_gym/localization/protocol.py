@@ -16,10 +16,16 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas
 from vc_gym.validation import positive_float
 
-__all__ = ["Tracker", "TrackerState", "check_frame_inputs", "check_reset_inputs"]
+__all__ = [
+    "Tracker",
+    "TrackerState",
+    "atlas_tracker_state",
+    "check_frame_inputs",
+    "check_reset_inputs",
+]
 
 
 @dataclass(frozen=True)
@@ -96,9 +102,9 @@ class Tracker(Protocol):
 
 
 def check_frame_inputs(
-    head_pan_deg: float, odometry: np.ndarray | tuple
+    head_pan_deg: float, odometry: np.ndarray | tuple, ready: bool = True
 ) -> tuple[float, float, float, float]:
-    """Validate one frame's head pan and odometry.
+    """Validate one frame's head pan and odometry (and that the tracker was reset).
 
     Returns
     -------
@@ -107,9 +113,13 @@ def check_frame_inputs(
 
     Raises
     ------
+    RuntimeError
+        If not ``ready`` (pass ``False`` when the tracker was never reset).
     ValueError
         On a non-finite pan, or odometry that is not three finite numbers.
     """
+    if not ready:
+        raise RuntimeError("call reset(atlas, camera, dt_s) before update()")
     odo = np.asarray(odometry, dtype=np.float64)
     if odo.shape != (3,) or not np.all(np.isfinite(odo)):
         raise ValueError(f"odometry must be 3 finite numbers, got {odometry!r}")
@@ -120,6 +130,27 @@ def check_frame_inputs(
     if not math.isfinite(pan):
         raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
     return pan, float(odo[0]), float(odo[1]), float(odo[2])
+
+
+def atlas_tracker_state(
+    atlas: CompassAtlas,
+    estimate: AtlasEstimate,
+    heading_deg: float,
+    heading_spread_deg: float,
+    position: tuple[float, float],
+    position_std_m: tuple[float, float],
+    belief: np.ndarray,
+) -> TrackerState:
+    """A :class:`TrackerState` whose goodness and atlas position come from ``estimate``."""
+    return TrackerState(
+        heading_deg=float(heading_deg),
+        heading_spread_deg=float(min(heading_spread_deg, 180.0)),
+        position=(float(position[0]), float(position[1])),
+        position_std_m=(float(position_std_m[0]), float(position_std_m[1])),
+        goodness=np.array([estimate.goodness[n] for n in atlas.names]),
+        belief=belief,
+        atlas_position=(float(estimate.position[0]), float(estimate.position[1])),
+    )
 
 
 def check_reset_inputs(atlas: object, camera: object, dt_s: object) -> float:
