@@ -18,8 +18,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     s = run_demo(args.out, seed=args.seed, learn_time_s=args.learn_time, tracker=args.tracker)
     dx, dy = (100 * v for v in s["stop_offset_m"])
+    how = "stopped" if s["stopped"] else f"did not stop (timed out after {s['sim_time_s']:.0f} s),"
     print(
-        f"stopped {s['home_error_m'] * 100:.1f} cm from home "
+        f"{how} {s['home_error_m'] * 100:.1f} cm from home "
         f"(offset x {dx:+.1f} cm, y {dy:+.1f} cm), "
         f"final heading error {s['final_heading_error_deg']:.1f} deg, "
         f"success: {s['success']}, {s['duration_s']:.0f} s"

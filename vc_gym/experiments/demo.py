@@ -138,6 +138,7 @@ def _plot(path: Path, record: EpisodeRecord, learned: LearningResult, top: TopVi
         d = np.hypot(true[:, 0] - record.home[0], true[:, 1] - record.home[1])
         ax3 = ax2.twinx()
         ax3.plot(np.arange(len(d)) * 0.1, d, color="tab:red", lw=1)
+        ax3.set_ylim(0.0, 1.1 * max(float(d.max()), 0.1))  # from 0: never an offset axis
         ax3.set_ylabel("true distance to home (m)", color="tab:red")
     ax2.set_xlabel("homing time (s)")
     ax2.set_ylabel("|heading error| (deg)", color="tab:blue")
