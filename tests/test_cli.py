@@ -64,3 +64,23 @@ def test_demo_runs_the_main_job(tmp_path, capsys):
         assert key in summary
     assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
     assert "cm from home" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["evaluate", "--tracker", "kalmann", "--episodes", "1"], "unknown tracker"),
+        (["demo", "--tracker", '{"type": "grid", "half_life_s": -1}'], "half_life_s"),
+        (["demo", "--tracker", "no_such_module:Tracker"], "cannot import"),
+    ],
+)
+def test_bad_trackers_fail_before_any_work(tmp_path, capsys, argv, message):
+    assert main([*argv, "--out", str(tmp_path / "out")]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_tracker_json_must_be_an_object(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["demo", "--tracker", "{not json"])
+    assert e.value.code == 2
+    assert "JSON" in capsys.readouterr().err

@@ -7,7 +7,17 @@ without it.
 from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
+from vc_gym.envs.homing import HomingFeatures, StopAction, make_homing_env
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
+from vc_gym.envs.learning import (
+    Learner,
+    LearningConfig,
+    LearningResult,
+    RobotFell,
+    ScriptedLearner,
+    ScriptedLearning,
+    kidnap_pose,
+)
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
 from vc_gym.envs.scenes import (
     SCENES,
@@ -24,12 +34,22 @@ __all__ = [
     "AiboRoomEnv",
     "CompassObservation",
     "HeadCameraSpec",
+    "HomingFeatures",
     "LEARNING_MODES",
     "LearnThenHomeEnv",
+    "Learner",
+    "LearningConfig",
+    "LearningResult",
     "OdometryNoise",
     "Quadruped",
+    "RobotFell",
     "Scene",
+    "ScriptedLearner",
+    "ScriptedLearning",
+    "StopAction",
     "build_scene",
+    "kidnap_pose",
+    "make_homing_env",
     "register_scene",
     "render_camera",
     "scene_names",

@@ -26,7 +26,7 @@ from vc_gym.compass import (
     CompassConfig,
     VisualCompass,
 )
-from vc_gym.experiments.output import save_figure
+from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.filters.grid import HeadingGridFilter
 from vc_gym.filters.kalman import KalmanHeadingFilter
 from vc_gym.filters.particle import ParticleFilter
@@ -201,15 +201,11 @@ def bench_filters(
 
 
 def _plot(path: Path, track: dict) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     truth = np.array(track["truth_deg"])
     unwrapped = np.degrees(np.unwrap(np.radians(truth)))
     t = np.arange(truth.size) * track["dt_s"]
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True, constrained_layout=True)
+    fig = new_figure(figsize=(10, 6), layout="constrained")
+    axes = fig.subplots(2, 1, sharex=True)
     axes[0].plot(t, unwrapped, "k", lw=2, label="true heading")
     for name, v in track.items():
         if not isinstance(v, dict):

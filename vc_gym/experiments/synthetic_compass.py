@@ -17,7 +17,7 @@ from tqdm import tqdm
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
-from vc_gym.experiments.output import save_figure, write_json
+from vc_gym.experiments.output import new_figure, save_figure, write_json
 from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
 
 __all__ = ["run_synthetic_compass"]
@@ -100,13 +100,8 @@ def run_synthetic_compass(
 
 
 def _plot(path: Path, panos: dict, curves: dict, example: tuple) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     img, test_yaw, est, headings = example
-    fig = plt.figure(figsize=(13, 9), constrained_layout=True)
+    fig = new_figure(figsize=(13, 9), layout="constrained")
     grid = fig.add_gridspec(3, 3)
     ax = fig.add_subplot(grid[0, :])
     pano = panos["room"]
