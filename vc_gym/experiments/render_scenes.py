@@ -11,15 +11,18 @@ import numpy as np
 
 from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.scenes import check_scene_name, scene_names
+from vc_gym.persistence import write_atomic
 
 __all__ = ["render_scene_pictures"]
 
 
 def _write_png(path: Path, rgb: np.ndarray) -> None:
-    tmp = path.with_name("." + path.name + ".tmp.png")
-    if not cv2.imwrite(str(tmp), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
-        raise OSError(f"could not write {path}")
-    os.replace(tmp, path)
+    def write(tmp: str) -> None:
+        # the temporary name ends in .png, so OpenCV picks the PNG encoder
+        if not cv2.imwrite(tmp, cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+            raise OSError(f"could not write {path}")
+
+    write_atomic(path, write)
 
 
 def render_scene_pictures(
