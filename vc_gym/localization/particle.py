@@ -172,9 +172,10 @@ class ParticleTracker:
             pf.replace(np.arange(self.n_particles), self._sensor_poses(est, pan, self.n_particles))
             self._fresh = False
         else:
-            pf.update(_RobustFrameSensor(self.sensor, pan, self.outlier), est)
+            ess = pf.update(_RobustFrameSensor(self.sensor, pan, self.outlier), est)
+            resampled = ess < pf.resample_threshold * self.n_particles  # as update decides
             k = int(round(self.inject_fraction * self.n_particles))
-            if k and np.all(pf.log_weights == pf.log_weights[0]):  # just resampled
+            if k and resampled:
                 idx = self.rng.choice(self.n_particles, size=k, replace=False)
                 pf.replace(idx, self._sensor_poses(est, pan, k))
         e = pf.estimate()
