@@ -371,6 +371,11 @@ class Quadruped:
 
         bc.setGravity(0.0, 0.0, -9.81)
         bc.setTimeStep(self._dt)
+        # Sorted contact pairs: without this the broadphase's pair order depends on the
+        # history of the client, so an episode's physics differed by ~1e-9 m depending
+        # on which episodes ran before it in the same process, and now and then such a
+        # difference flipped a stop decision.
+        bc.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
         kinematic = locomotion == "kinematic"
         self.body_id: int = bc.loadURDF(
             A1_URDF,
