@@ -303,3 +303,31 @@ def test_odometry_drift_matches_configured_noise():
     env.close()
     assert np.std(ratios) == pytest.approx(0.1, rel=0.35)
     assert np.mean(ratios) == pytest.approx(1.0, abs=0.05)
+
+
+def test_an_episode_does_not_depend_on_the_episodes_before_it():
+    """reset(seed=s) gives the same episode in a fresh env and after other episodes
+    (the first reset builds the scene; physics keeps contact caches between resets)."""
+    actions = [np.array([0.6, 0.1, 0.3, 0.2, 0.0], np.float32)] * 15
+
+    def episode(env):
+        obs, info = env.reset(seed=5)
+        poses = [info["pose"]]
+        for a in actions:
+            obs, _, _, _, info = env.step(a)
+            poses.append(info["pose"])
+        return np.array(poses), obs["image"]
+
+    fresh = make("vc_gym/AiboRoom-v0")
+    first = episode(fresh)
+    again = episode(fresh)  # no rebuild this time
+    fresh.close()
+    used = make("vc_gym/AiboRoom-v0")
+    used.reset(seed=1)
+    for _ in range(20):
+        used.step(np.array([1.0, 0.0, -0.5, 0.0, 0.0], np.float32))
+    after = episode(used)
+    used.close()
+    for other in (again, after):
+        np.testing.assert_array_equal(first[0], other[0])
+        np.testing.assert_array_equal(first[1], other[1])

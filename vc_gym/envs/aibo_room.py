@@ -211,11 +211,11 @@ class AiboRoomEnv(gym.Env):
         bc.resetSimulation()
         rng = np.random.default_rng(scene_seed)
         self._scene = build_scene(bc, self.scene_name, rng=rng, randomize=self.randomize)
+        # the robot's Generator is replaced at every reset (below); drawing its seed
+        # here from np_random would make a reset that rebuilds the scene consume one
+        # more number than one that does not, so reset(seed=s) would depend on history
         self._robot = Quadruped(
-            bc,
-            self.locomotion,
-            rng=np.random.default_rng(self.np_random.integers(2**63)),
-            odometry_noise=self.odometry_noise,
+            bc, self.locomotion, rng=np.random.default_rng(0), odometry_noise=self.odometry_noise
         )
         self._projection = self.camera.projection(bc)
         self._top_view = None
