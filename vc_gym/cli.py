@@ -275,8 +275,9 @@ def build_parser() -> argparse.ArgumentParser:
             "One learn-then-home episode in the simulated robot lab with the scripted agents "
             "(paper 4.3, 5.2): learn the panorama at 4 spots 1 m around home (8 x 45 deg, "
             "head scanning), normalise at home, get kidnapped to a random pose, walk home "
-            "with the orientational and translational filters. Writes DIR/summary.json "
-            "(home error, heading error, success, duration) and DIR/demo.png."
+            "with a tracker (default: the paper's orientational and translational filters). "
+            "It is the first kidnapping of 'vc-gym evaluate' with the same --seed. Writes "
+            "DIR/summary.json (home error, heading error, success, duration) and DIR/demo.png."
         ),
     )
     p.add_argument("--out", default="vc_gym_demo", metavar="DIR", help="output folder")
