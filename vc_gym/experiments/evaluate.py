@@ -225,9 +225,10 @@ def _plot(path: Path, offsets_cm: np.ndarray, summary: dict) -> None:
     name = "scripted" if summary["agent"] == "scripted" else Path(summary["agent"]).parent.name
     tracker = summary["tracker"] if isinstance(summary["tracker"], str) else "custom"
     ax.set_title(
-        f"{name} ({tracker} tracker), {summary['episodes']} kidnappings: "
+        f"{name} ({tracker} tracker), {summary['episodes']} kidnappings:\n"
         f"success {summary['success_rate']:.0%}, "
-        f"mean distance {summary['mean_stop_distance_cm']:.0f} cm"
+        f"mean distance {summary['mean_stop_distance_cm']:.0f} cm",
+        fontsize=10,
     )
     ax.legend(fontsize=7, loc="upper right")
     save_figure(fig, path, dpi=100)
