@@ -453,6 +453,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, FileNotFoundError) as e:
         print(f"vc-gym {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except RuntimeError as e:  # a failure during the work (a dead worker, a fall, ...)
+        print(f"vc-gym {args.command}: failed: {e}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

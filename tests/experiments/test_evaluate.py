@@ -47,3 +47,23 @@ def test_evaluate_rejects_bad_numbers():
         evaluate_agent(relearn="sometimes")
     with pytest.raises(ValueError):
         evaluate_agent(max_homing_s=float("nan"))
+
+
+class DyingTracker:
+    """A tracker whose worker process dies at the first frame (as if OOM-killed)."""
+
+    def reset(self, atlas, camera, dt_s):
+        pass
+
+    def update(self, image, head_pan_deg, odometry):
+        import os
+
+        os._exit(9)
+
+
+def test_a_dead_worker_is_a_clear_error_not_a_hang(capsys):
+    # the learning phase is short; the first homing frame kills each worker
+    args = ["evaluate", "--episodes", "2", "--workers", "2", "--learn-time", "0.2"]
+    code = main([*args, "--tracker", f"{__name__}:DyingTracker"])
+    assert code == 1
+    assert "worker process died" in capsys.readouterr().err

@@ -16,6 +16,8 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import time
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -143,16 +145,28 @@ def evaluate_agent(
         finally:
             _WORKER.pop("run").close()
     else:
+        # concurrent.futures notices a worker that dies (OOM killer, a crash in a
+        # native library) and fails every pending job; multiprocessing.Pool would
+        # wait for its result forever
         ctx = mp.get_context("spawn")
-        with ctx.Pool(workers, initializer=_init_pool_worker, initargs=init) as pool:
-            results = list(
-                tqdm(
-                    pool.imap(_episode, jobs),
-                    total=len(jobs),
-                    desc="episodes",
-                    disable=not progress,
+        with ProcessPoolExecutor(
+            workers, mp_context=ctx, initializer=_init_pool_worker, initargs=init
+        ) as pool:
+            try:
+                results = list(
+                    tqdm(
+                        pool.map(_episode, jobs),
+                        total=len(jobs),
+                        desc="episodes",
+                        disable=not progress,
+                    )
                 )
-            )
+            except BrokenProcessPool as exc:
+                raise RuntimeError(
+                    "a worker process died during the evaluation (killed, or crashed in "
+                    "native code); no figures were written. Rerun, or use --workers 1 "
+                    "to see the error in this process"
+                ) from exc
     costs = [r.pop("tracker_ms_per_update") for r in results]
     costs = [c for c in costs if c is not None]
     offsets = np.array([r["stop_offset_m"] for r in results]) * 100.0
