@@ -440,3 +440,24 @@ def test_replace_overwrites_chosen_particles_only():
     ):
         with pytest.raises(ValueError):
             pf.replace(idx, poses)
+
+
+def test_resampling_injects_poses_from_a_given_sampler():
+    pf = ParticleFilter(
+        100, bounds=(-1, 1, -1, 1), rng=np.random.default_rng(0), inject_fraction=0.1
+    )
+    asked = []
+
+    def at_the_corner(k):
+        asked.append(k)
+        return np.tile([5.0, 5.0, 90.0], (k, 1))
+
+    # a sharp sensor: the ESS collapses, so this update resamples and injects
+    pf.update(GaussianPoseSensor(0.05, None), np.array([0.0, 0.0, 0.0]), inject=at_the_corner)
+    assert asked == [10]
+    corner = np.all(pf.particles == [5.0, 5.0, 90.0], axis=1)
+    assert corner.sum() == 10
+    pf.update(GaussianPoseSensor(50.0, None), np.array([0.0, 0.0, 0.0]), inject=at_the_corner)
+    assert asked == [10]  # a flat sensor: no resampling, nothing injected
+    with pytest.raises(ValueError):
+        pf.resample(inject=lambda k: np.zeros((k, 2)))

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -338,7 +339,12 @@ class ParticleFilter:
         p[:, 1] += d[:, 0] * sn + d[:, 1] * c
         p[:, 2] = wrap360(p[:, 2] + d[:, 2])
 
-    def update(self, sensor: PoseSensor, observation: Any) -> float:
+    def update(
+        self,
+        sensor: PoseSensor,
+        observation: Any,
+        inject: Callable[[int], np.ndarray] | None = None,
+    ) -> float:
         """Sensor update, ``w_i ∝ w_i · p(z | x_i)`` in the log domain (paper eq. 17).
 
         The log-likelihoods are validated with
@@ -353,6 +359,8 @@ class ParticleFilter:
             read-only ``(N, 3)`` view of the particles.
         observation : Any
             Passed through to the sensor.
+        inject : callable, optional
+            Passed to :meth:`resample` if this update resamples.
 
         Returns
         -------
@@ -391,10 +399,10 @@ class ParticleFilter:
         self._logw = logw
         ess = self.ess
         if ess < self._threshold * self._n:
-            self.resample()
+            self.resample(inject)
         return ess
 
-    def resample(self) -> None:
+    def resample(self, inject: Callable[[int], np.ndarray] | None = None) -> None:
         """Systematic resampling, then optional injection of uniform poses.
 
         One offset ``u ~ U[0, 1/N)`` is drawn from the filter's Generator and the
@@ -404,7 +412,10 @@ class ParticleFilter:
         Weights become uniform. Then, if ``inject_fraction > 0``,
         ``round(inject_fraction * N)`` particles chosen at random (without
         replacement) are replaced by uniform poses in ``bounds`` with uniform heading,
-        so that the filter can recover when the robot was kidnapped.
+        so that the filter can recover when the robot was kidnapped. ``inject(k)``,
+        if given, draws the ``k`` injected poses instead (e.g. from the current
+        measurement: "sensor resetting", Lenser & Veloso 2000); it must return a
+        finite ``(k, 3)`` array.
 
         filterpy's resampling helpers are deliberately not used: they draw from
         NumPy's global random state, which would break reproducibility.
@@ -431,7 +442,10 @@ class ParticleFilter:
         k = int(round(self._inject * self._n))
         if k > 0:
             replace = self._rng.choice(self._n, size=k, replace=False)
-            self._particles[replace] = self._uniform_poses(k)
+            if inject is None:
+                self._particles[replace] = self._uniform_poses(k)
+            else:
+                self.replace(replace, inject(k))
 
     def replace(self, indices: np.ndarray, poses: np.ndarray) -> None:
         """Overwrite the particles at ``indices`` with ``poses``; weights are unchanged.

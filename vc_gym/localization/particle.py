@@ -135,7 +135,10 @@ class ParticleTracker:
         self.atlas, self.camera = atlas, camera
         self.rng = np.random.default_rng(self.seed)
         self.filter = ParticleFilter(
-            self.n_particles, bounds=self.field_bounds(atlas), rng=self.rng
+            self.n_particles,
+            bounds=self.field_bounds(atlas),
+            rng=self.rng,
+            inject_fraction=self.inject_fraction,
         )
         self._fresh = True
         self.sensor = AtlasPoseSensor(
@@ -172,12 +175,11 @@ class ParticleTracker:
             pf.replace(np.arange(self.n_particles), self._sensor_poses(est, pan, self.n_particles))
             self._fresh = False
         else:
-            ess = pf.update(_RobustFrameSensor(self.sensor, pan, self.outlier), est)
-            resampled = ess < pf.resample_threshold * self.n_particles  # as update decides
-            k = int(round(self.inject_fraction * self.n_particles))
-            if k and resampled:
-                idx = self.rng.choice(self.n_particles, size=k, replace=False)
-                pf.replace(idx, self._sensor_poses(est, pan, k))
+            pf.update(
+                _RobustFrameSensor(self.sensor, pan, self.outlier),
+                est,
+                inject=lambda k: self._sensor_poses(est, pan, k),
+            )
         e = pf.estimate()
         th = pf.particles[:, 2]
         belief = np.bincount(np.floor(th).astype(np.int64) % 360, weights=pf.weights, minlength=360)
