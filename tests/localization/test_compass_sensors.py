@@ -59,3 +59,12 @@ def test_compass_sensor_interpolates_between_grid_points(room_pano, room_compass
     half = sensor.heading_log_likelihood(img, np.array([40.5, 359.5]))
     assert half[0] == pytest.approx(0.5 * (on_grid[40] + on_grid[41]))
     assert half[1] == pytest.approx(0.5 * (on_grid[359] + on_grid[0]))
+
+
+def test_tempered_distribution_known_answers():
+    from vc_gym.localization.sensors import tempered_distribution
+
+    ll = np.log(np.array([1.0, 4.0, 0.0]))  # the last state ruled out
+    np.testing.assert_allclose(tempered_distribution(ll, 1.0), [0.2, 0.8, 0.0])
+    np.testing.assert_allclose(tempered_distribution(ll, 2.0), [1 / 3, 2 / 3, 0.0])
+    assert tempered_distribution(np.full(3, -np.inf), 1.0) is None

@@ -13,14 +13,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from vc_gym.envs.learning import LearningConfig
+from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["ScriptedHomingPolicy"]
-
-#: Head pans cycled while the robot stands (the learning phase's scan).
-HEAD_SCAN_DEG = LearningConfig().head_scan_deg
-
 
 class ScriptedHomingPolicy:
     """The paper's homing behaviour on :class:`~vc_gym.envs.CompassObservation` outputs.

@@ -16,7 +16,7 @@ import numpy as np
 from gymnasium import spaces
 
 from vc_gym.envs.compass_observation import CompassObservation
-from vc_gym.envs.learning import LearningConfig
+from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.localization import TrackerSpec
 from vc_gym.validation import nonnegative_float, positive_float
 
@@ -87,7 +87,7 @@ class StopAction(gym.Wrapper):
         self.max_forward = positive_float("max_forward", max_forward)
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
         nonnegative_float("min_walk_s", min_walk_s)
-        self._pans = LearningConfig().head_scan_deg
+        self._pans = HEAD_SCAN_DEG
         self._n = inner.shape[0]
         self.action_space = spaces.Box(-1.0, 1.0, (3,), np.float32)
         self._max_hold = 10**5

@@ -27,6 +27,7 @@ from vc_gym.poses import compose
 from vc_gym.validation import positive_float
 
 __all__ = [
+    "HEAD_SCAN_DEG",
     "HOME",
     "SPOT_NAMES",
     "Learner",
@@ -41,6 +42,8 @@ __all__ = [
 #: Home of the task: the world origin (robolab: the centre of the kickoff circle).
 HOME = (0.0, 0.0)
 SPOT_NAMES = ("east", "north", "west", "south")
+#: Head pans cycled while the robot learns a direction, and while it stands still homing.
+HEAD_SCAN_DEG = (-40.0, -20.0, 0.0, 20.0, 40.0, 20.0, 0.0, -20.0)
 
 
 class RobotFell(Exception):
@@ -70,7 +73,7 @@ class LearningConfig:
 
     spot_distance_m: float = 1.0
     learn_time_s: float = 5.0
-    head_scan_deg: tuple[float, ...] = (-40.0, -20.0, 0.0, 20.0, 40.0, 20.0, 0.0, -20.0)
+    head_scan_deg: tuple[float, ...] = HEAD_SCAN_DEG
     normalise_directions: int = 12
     half_life_s: float = 0.3
     compass: CompassConfig = field(default_factory=CompassConfig)

@@ -16,7 +16,10 @@ from vc_gym.localization.protocol import (
     check_frame_inputs,
     check_reset_inputs,
 )
-from vc_gym.localization.sensors import best_spot_heading_log_likelihood
+from vc_gym.localization.sensors import (
+    best_spot_heading_log_likelihood,
+    tempered_distribution,
+)
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["KalmanTracker"]
@@ -87,12 +90,9 @@ class KalmanTracker:
         self.rejections = 0
 
     def _measurement(self, ll: np.ndarray) -> tuple[float, float] | None:
-        ll = ll / self.heading_temperature
-        top = ll.max()
-        if not np.isfinite(top):
+        p = tempered_distribution(ll, self.heading_temperature)
+        if p is None:
             return None  # the compass rules out every heading: no information
-        p = np.exp(ll - top)
-        p /= p.sum()
         h = self.headings_deg
         return circular_mean(h, p), max(circular_std(h, p), self.min_spread_deg)
 

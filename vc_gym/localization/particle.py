@@ -12,7 +12,11 @@ from vc_gym.localization.protocol import (
     check_frame_inputs,
     check_reset_inputs,
 )
-from vc_gym.localization.sensors import AtlasPoseSensor, best_spot_heading_log_likelihood
+from vc_gym.localization.sensors import (
+    AtlasPoseSensor,
+    best_spot_heading_log_likelihood,
+    tempered_distribution,
+)
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["ParticleTracker"]
@@ -149,10 +153,9 @@ class ParticleTracker:
         """``k`` poses drawn from one frame's evidence (position and heading)."""
         headings = np.arange(360.0)
         ll = best_spot_heading_log_likelihood(self.atlas, est, headings + pan)
-        ll = ll / self.heading_temperature
-        top = ll.max()
-        p = np.exp(ll - top) if np.isfinite(top) else np.ones(360)
-        p /= p.sum()
+        p = tempered_distribution(ll, self.heading_temperature)
+        if p is None:  # every heading ruled out: draw them uniformly
+            p = np.full(360, 1.0 / 360.0)
         out = np.empty((k, 3))
         out[:, :2] = est.position + self.rng.normal(0.0, self.position_noise_m, (k, 2))
         out[:, 2] = self.rng.choice(headings, size=k, p=p) + self.rng.uniform(-0.5, 0.5, k)

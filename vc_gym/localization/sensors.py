@@ -21,6 +21,7 @@ __all__ = [
     "AtlasPoseSensor",
     "CompassHeadingSensor",
     "best_spot_heading_log_likelihood",
+    "tempered_distribution",
 ]
 
 
@@ -46,6 +47,26 @@ def best_spot_heading_log_likelihood(
     best = max(estimate.goodness, key=estimate.goodness.get)
     step = atlas.compasses[0].config.heading_step_deg
     return interp_circular(estimate.estimates[best].log_likelihood, step, headings_deg)
+
+
+def tempered_distribution(log_likelihood: np.ndarray, temperature: float) -> np.ndarray | None:
+    """``softmax(log_likelihood / temperature)``: a likelihood turned into probabilities.
+
+    The raw eq. 16 product is far sharper than the compass is right; dividing its log
+    by a temperature before normalising widens it (a uniform prior otherwise).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        Probabilities summing to 1, or ``None`` if every entry is ``-inf`` (the
+        sensor rules out every state: no information).
+    """
+    ll = np.asarray(log_likelihood, dtype=np.float64) / temperature
+    top = ll.max()
+    if not np.isfinite(top):
+        return None
+    p = np.exp(ll - top)
+    return p / p.sum()
 
 
 class CompassHeadingSensor:
