@@ -64,7 +64,7 @@ def test_compass_sensor_interpolates_between_grid_points(room_pano, room_compass
 def test_tempered_distribution_known_answers():
     from vc_gym.localization.sensors import tempered_distribution
 
-    ll = np.log(np.array([1.0, 4.0, 0.0]))  # the last state ruled out
+    ll = np.array([0.0, np.log(4.0), -np.inf])  # the last state ruled out
     np.testing.assert_allclose(tempered_distribution(ll, 1.0), [0.2, 0.8, 0.0])
     np.testing.assert_allclose(tempered_distribution(ll, 2.0), [1 / 3, 2 / 3, 0.0])
     assert tempered_distribution(np.full(3, -np.inf), 1.0) is None

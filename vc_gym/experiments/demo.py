@@ -132,12 +132,12 @@ def _plot(path: Path, record: EpisodeRecord, learned: LearningResult, top: TopVi
     )
     ax.legend(loc="lower left", fontsize=8)
     if record.heading_error:
-        t = np.arange(len(record.heading_error)) * 0.1
+        t = np.arange(len(record.heading_error)) * record.dt_s
         ax2.plot(t, np.maximum(np.abs(record.heading_error), 1e-2), color="tab:blue")
         ax2.set_yscale("log")
         d = np.hypot(true[:, 0] - record.home[0], true[:, 1] - record.home[1])
         ax3 = ax2.twinx()
-        ax3.plot(np.arange(len(d)) * 0.1, d, color="tab:red", lw=1)
+        ax3.plot(np.arange(len(d)) * record.dt_s, d, color="tab:red", lw=1)
         ax3.set_ylim(0.0, 1.1 * max(float(d.max()), 0.1))  # from 0: never an offset axis
         ax3.set_ylabel("true distance to home (m)", color="tab:red")
     ax2.set_xlabel("homing time (s)")

@@ -49,6 +49,8 @@ class EpisodeRecord:
     decisions: int = 0
     sim_time_s: float = 0.0
     total_return: float = 0.0
+    #: time per step (the env's control period), seconds
+    dt_s: float = 0.1
     #: wall time in the tracker's updates and their count (not part of :meth:`summary`)
     tracker_time_s: float = 0.0
     tracker_updates: int = 0
@@ -187,7 +189,7 @@ def run_episode(
     home = tuple(float(v) for v in getattr(u, "home", (0.0, 0.0)))
     record = EpisodeRecord(seed=seed, start_pose=tuple(float(v) for v in info["pose"]), home=home)
     t0, n0 = _tracker_counters(env)
-    dt = float(u.control_dt)
+    dt = record.dt_s = float(u.control_dt)
     limit = int(round(getattr(u, "max_homing_s", 60.0) / dt))
     with tqdm(total=limit, desc="homing", unit="step", disable=not progress) as bar:
         while True:
