@@ -19,15 +19,6 @@ FOV_V = math.degrees(2.0 * math.atan(math.tan(math.radians(HFOV / 2.0)) * H / W)
 ROBOT_RADIUS = 0.25
 
 
-@pytest.fixture
-def bc():
-    client = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
-    try:
-        yield client
-    finally:
-        client.disconnect()
-
-
 def head_view(bc, scene: Scene, yaw_deg: float, eye=None, size=(W, H)) -> np.ndarray:
     """What a camera 0.3 m above the field centre sees at ``yaw_deg`` (pitch 0)."""
     if eye is None:

@@ -7,10 +7,8 @@ import warnings
 
 import gymnasium as gym
 import numpy as np
-import pybullet
 import pytest
 from gymnasium.utils.env_checker import check_env
-from pybullet_utils import bullet_client
 
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.envs import textures
@@ -60,15 +58,6 @@ def box_room_name():
         yield BOX_ROOM
     finally:
         unregister_scene(BOX_ROOM)
-
-
-@pytest.fixture
-def bc():
-    client = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
-    try:
-        yield client
-    finally:
-        client.disconnect()
 
 
 def wall_seen(image: np.ndarray) -> str:

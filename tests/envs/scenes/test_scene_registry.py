@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-import pybullet
 import pytest
-from pybullet_utils import bullet_client
 
 import vc_gym.envs
 from vc_gym.envs.scenes import (
@@ -18,15 +16,6 @@ from vc_gym.envs.scenes import (
     unregister_scene,
 )
 from vc_gym.envs.scenes.base import Builder
-
-
-@pytest.fixture
-def bc():
-    client = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
-    try:
-        yield client
-    finally:
-        client.disconnect()
 
 
 @pytest.fixture
