@@ -29,9 +29,11 @@ __all__ = ["EpisodeRecord", "HomingRun", "make_homing_run", "run_episode"]
 class EpisodeRecord:
     """What happened in one homing episode (world frame, metres and degrees).
 
-    ``true`` and ``estimated`` hold one ``(x, y, heading)`` per step; ``estimated`` is
-    the tracker's belief (``NaN`` where it had none) and ``heading_error`` the wrapped
-    difference estimated minus true heading.
+    ``true`` and ``estimated`` hold one ``(x, y, heading)`` per decision of the agent
+    (a step of the scripted agent; a learned agent's stop decision, which holds the
+    robot still until the episode ends, is one entry); ``estimated`` is the tracker's
+    belief (``NaN`` where it had none) and ``heading_error`` the wrapped difference
+    estimated minus true heading.
     """
 
     seed: int | None
