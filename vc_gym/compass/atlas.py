@@ -9,17 +9,26 @@ the position estimate is the likelihood-weighted mean of the spots (eq. 30).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from vc_gym.compass.camera import Camera
+from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
-from vc_gym.errors import NotLearnedError
+from vc_gym.errors import MapFileError, NotLearnedError
+from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
 
 __all__ = ["CompassAtlas", "AtlasEstimate"]
+
+ATLAS_SCHEMA = "vc_gym.CompassAtlas"
+ATLAS_SCHEMA_VERSION = 1
+#: Most spots an atlas file may declare (a guard against a hostile header).
+_MAX_SPOTS = 1024
 
 
 @dataclass(frozen=True)
@@ -221,3 +230,110 @@ class CompassAtlas:
             weights={n: float(v) for n, v in zip(self.names, w, strict=True)},
             estimates=dict(zip(self.names, ests, strict=True)),
         )
+
+    # ------------------------------------------------------------------ persistence
+    def save(self, path: str | os.PathLike, metadata: Mapping[str, object] | None = None) -> Path:
+        """Save every spot's map, the spot layout and the home normalisation, atomically.
+
+        One ``.npz`` file (no pickling); colour classes shared by all spots are stored
+        once. ``metadata`` (JSON-serialisable: how the atlas was learned) is kept with
+        it and returned by :meth:`load_with_metadata`.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written (``.npz`` appended if missing).
+        """
+        shared = all(vc.colors is self.compasses[0].colors for vc in self.compasses)
+        header = {
+            "names": list(self.names),
+            "positions": self.positions.tolist(),
+            "home": self.home,
+            "home_position": list(self.home_position),
+            "sharpness": self.sharpness,
+            "is_normalized": self.is_normalized,
+            "kappa": self._kappa,
+            "shared_colors": shared,
+            "metadata": dict(metadata or {}),
+        }
+        arrays: dict[str, np.ndarray] = {
+            "atlas": json_array(header),
+            "home_scores": self._home_scores.astype(np.float64),
+            "home_headings": self._home_headings.astype(np.float64),
+        }
+        if shared:
+            if self.compasses[0].colors is None:
+                raise NotLearnedError("nothing to save: the compasses have no colour classes")
+            arrays.update(self.compasses[0].colors.to_arrays())
+        for i, vc in enumerate(self.compasses):
+            for key, a in vc.to_arrays(with_colors=not shared).items():
+                arrays[f"spot{i}/{key}"] = a
+        return save_npz_atomic(path, ATLAS_SCHEMA, ATLAS_SCHEMA_VERSION, arrays)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> CompassAtlas:
+        """Load an atlas written by :meth:`save` (see :meth:`load_with_metadata`)."""
+        return cls.load_with_metadata(path)[0]
+
+    @classmethod
+    def load_with_metadata(cls, path: str | os.PathLike) -> tuple[CompassAtlas, dict]:
+        """Load an atlas written by :meth:`save` and the metadata saved with it.
+
+        Raises
+        ------
+        MapFileError
+            Missing, empty or corrupt file, another schema or version, or any entry
+            that does not match the header (the message names the file and entry).
+        """
+        arrays = load_npz_checked(path, ATLAS_SCHEMA, ATLAS_SCHEMA_VERSION)
+        header = read_json_array(arrays, "atlas", path)
+        try:
+            names = [str(n) for n in header["names"]]
+            positions = [(float(x), float(y)) for x, y in header["positions"]]
+            home = str(header["home"])
+            hx, hy = (float(v) for v in header["home_position"])
+            sharpness = float(header["sharpness"])
+            normalized = header["is_normalized"]
+            kappa = float(header["kappa"])
+            shared = header["shared_colors"]
+            metadata = header["metadata"]
+        except (KeyError, TypeError, ValueError) as e:
+            raise MapFileError(f"{path}: invalid atlas header ({type(e).__name__}: {e})") from None
+        if not 1 <= len(names) <= _MAX_SPOTS or len(positions) != len(names):
+            raise MapFileError(f"{path}: header declares {len(names)} spots / positions")
+        if not isinstance(normalized, bool) or not isinstance(shared, bool):
+            raise MapFileError(f"{path}: is_normalized and shared_colors must be booleans")
+        if not isinstance(metadata, dict):
+            raise MapFileError(f"{path}: metadata must be a JSON object")
+        colors = None
+        if shared:
+            try:
+                colors = ColorClasses.from_arrays(arrays)
+            except ValueError as e:
+                raise MapFileError(f"{path}: invalid colour classes ({e})") from None
+        spots = {}
+        for i, (name, pos) in enumerate(zip(names, positions, strict=True)):
+            prefix = f"spot{i}/"
+            sub = {k[len(prefix) :]: a for k, a in arrays.items() if k.startswith(prefix)}
+            vc = VisualCompass.from_arrays(sub, f"{path} (spot {name!r})", colors=colors)
+            spots[name] = (pos, vc)
+        try:
+            atlas = cls(spots, home=home, home_position=(hx, hy), sharpness=sharpness)
+        except ValueError as e:
+            raise MapFileError(f"{path}: {e}") from None
+        n = len(names)
+        scores, headings = arrays.get("home_scores"), arrays.get("home_headings")
+        for key, a in (("home_scores", scores), ("home_headings", headings)):
+            if a is None or a.ndim != 2 or a.shape[1] != n or a.dtype.kind != "f":
+                raise MapFileError(f"{path}: entry {key!r} missing or not a (frames, {n}) array")
+            if not np.all(np.isfinite(a)):
+                raise MapFileError(f"{path}: entry {key!r} is not finite")
+        if scores.shape != headings.shape or (normalized and scores.shape[0] == 0):
+            raise MapFileError(f"{path}: home normalisation entries do not match")
+        if not (math.isfinite(kappa) and kappa > 0):
+            raise MapFileError(f"{path}: invalid kernel concentration {kappa}")
+        atlas._home_scores = scores.astype(np.float64)
+        atlas._home_headings = headings.astype(np.float64)
+        atlas._kappa = kappa
+        atlas.is_normalized = normalized
+        return atlas, metadata

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -497,6 +497,14 @@ class VisualCompass:
 
         Returns the path written (``.npz`` appended if missing).
         """
+        return save_npz_atomic(path, MAP_SCHEMA, MAP_SCHEMA_VERSION, self.to_arrays())
+
+    def to_arrays(self, with_colors: bool = True) -> dict[str, np.ndarray]:
+        """Config, map and (unless ``with_colors=False``) colour classes as plain arrays.
+
+        What :meth:`save` writes and :meth:`from_arrays` reads; a
+        :class:`~vc_gym.compass.CompassAtlas` stores shared colour classes once.
+        """
         if self._colors is None:
             raise NotLearnedError("nothing to save: the compass has no colour classes yet")
         arrays = {
@@ -506,9 +514,10 @@ class VisualCompass:
             "frames_learned": np.array(self._frames, dtype=np.int64),
             "exposure_reference": np.array(self._exposure_ref, dtype=np.float64),
             "learned_sizes": np.array(sorted(self._sizes), dtype=np.int64).reshape(-1, 2),
-            **self._colors.to_arrays(),
         }
-        return save_npz_atomic(path, MAP_SCHEMA, MAP_SCHEMA_VERSION, arrays)
+        if with_colors:
+            arrays.update(self._colors.to_arrays())
+        return arrays
 
     @classmethod
     def load(cls, path: str | os.PathLike, config: CompassConfig | None = None) -> VisualCompass:
@@ -529,6 +538,35 @@ class VisualCompass:
             or arrays whose shapes do not match the stored config.
         """
         arrays = load_npz_checked(path, MAP_SCHEMA, MAP_SCHEMA_VERSION)
+        return cls.from_arrays(arrays, path, config)
+
+    @classmethod
+    def from_arrays(
+        cls,
+        arrays: Mapping[str, np.ndarray],
+        source: str | os.PathLike,
+        config: CompassConfig | None = None,
+        colors: ColorClasses | None = None,
+    ) -> VisualCompass:
+        """Rebuild a compass from :meth:`to_arrays` output, checking every entry.
+
+        Parameters
+        ----------
+        arrays : mapping
+            The arrays (e.g. read from an ``.npz`` file).
+        source : path-like
+            Named in error messages (the file the arrays came from).
+        config : CompassConfig, optional
+            If given, the stored config must equal it.
+        colors : ColorClasses, optional
+            Colour classes to use instead of reading them from ``arrays``.
+
+        Raises
+        ------
+        MapFileError
+            Naming ``source`` and the entry at fault.
+        """
+        path = source
         raw = read_json_array(arrays, "config", path)
         try:
             stored = CompassConfig.from_dict(raw)  # type: ignore[arg-type]
@@ -536,10 +574,11 @@ class VisualCompass:
             raise MapFileError(f"{path}: invalid config ({e})") from None
         if config is not None and stored != config:
             raise MapFileError(f"{path}: was learned with {stored}, expected {config}")
-        try:
-            colors = ColorClasses.from_arrays(arrays)
-        except ValueError as e:
-            raise MapFileError(f"{path}: invalid colour classes ({e})") from None
+        if colors is None:
+            try:
+                colors = ColorClasses.from_arrays(arrays)
+            except ValueError as e:
+                raise MapFileError(f"{path}: invalid colour classes ({e})") from None
         vc = cls(stored, colors)
         expect = {
             "counts": vc._counts.shape,

@@ -1,0 +1,570 @@
+"""Experiments as independent jobs, run by a backend and saved as they finish.
+
+An experiment splits its work into :class:`Job` s (one kidnapping, one grid position, one
+parameter value): a job names a top-level function (``"package.module:function"``) and its
+JSON keyword arguments, and returns a JSON object of figures. Its result must depend only
+on its arguments (seeds and the paths of saved atlases), never on which worker ran what
+before it, so the same seed gives the same figures whatever backend or worker count ran
+the jobs.
+
+:class:`ExperimentRun` owns an experiment's output folder: every finished job is written
+to ``DIR/jobs/<stage>/<key>.json`` at once, so an interrupted run resumes where it stopped
+(no finished job is redone, none is lost). A job that raises, or whose worker dies, is
+retried once and then reported in ``results.json`` (``failed_jobs``), never dropped.
+:meth:`ExperimentRun.finish` writes ``results.json`` (figures only: the same seed gives the
+same bytes) and ``run.json`` (timings, jobs per second, backend, package versions).
+
+Backends: :class:`LocalBackend` (a process pool; one worker runs the jobs in this
+process) and :class:`RayBackend` (Ray: a local instance, or an existing cluster by
+address). Both keep their workers' numeric libraries single-threaded: the workers are
+the parallelism (DESIGN.md).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import importlib
+import json
+import math
+import multiprocessing as mp
+import os
+import platform
+import time
+import traceback
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from vc_gym.experiments.output import write_json
+
+__all__ = [
+    "BACKENDS",
+    "Job",
+    "JobOutcome",
+    "ExperimentRun",
+    "LocalBackend",
+    "RayBackend",
+    "call_job",
+    "check_out_dir",
+    "make_backend",
+    "worker_cache",
+]
+
+#: Key of a job's output that holds wall-clock figures: kept in ``run.json``, never in
+#: ``results.json``.
+TIMING = "timing"
+BACKENDS = ("local", "ray")
+#: Environment of every worker: one thread per numeric library.
+SINGLE_THREADED = {
+    "OMP_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENCV_FOR_THREADS_NUM": "1",
+}
+
+
+@dataclass(frozen=True)
+class Job:
+    """One independent piece of an experiment.
+
+    Attributes
+    ----------
+    key : str
+        Unique within its stage and safe as a file name (``"episode-0007"``).
+    fn : str
+        The function to call, ``"package.module:function"`` (top level, importable by
+        every worker).
+    kwargs : mapping
+        Its keyword arguments (JSON values only, so that a job can be saved and
+        compared when a run resumes).
+    """
+
+    key: str
+    fn: str
+    kwargs: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.key or any(c in self.key for c in '/\\:*?"<>|') or self.key[0] == ".":
+            raise ValueError(f"job key {self.key!r} is not a safe file name")
+        if ":" not in self.fn:
+            raise ValueError(f"job fn must be 'package.module:function', got {self.fn!r}")
+        try:
+            json.dumps(dict(self.kwargs), allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"job {self.key!r}: kwargs must be JSON values ({exc})") from None
+
+
+@dataclass
+class JobOutcome:
+    """What became of a job: its output, or the error of its last attempt."""
+
+    key: str
+    ok: bool
+    output: dict[str, Any] | None
+    error: str | None
+    attempts: int
+    seconds: float | None
+    resumed: bool = False
+
+
+def _resolve(fn: str) -> Callable[..., Any]:
+    module, _, name = fn.partition(":")
+    obj: Any = importlib.import_module(module)
+    for part in name.split("."):
+        obj = getattr(obj, part)
+    if not callable(obj):
+        raise TypeError(f"{fn} is not callable")
+    return obj
+
+
+def call_job(fn: str, kwargs: Mapping[str, Any]) -> dict[str, Any]:
+    """Run a job's function in this process and return its output, JSON-normalised.
+
+    The output is passed through JSON so that a fresh result and one read back from a
+    saved job file are the same Python values (lists, floats, ...).
+    """
+    out = _resolve(fn)(**dict(kwargs))
+    if not isinstance(out, Mapping):
+        raise TypeError(f"{fn} returned {type(out).__name__}, expected a dict of figures")
+    return json.loads(json.dumps(dict(out), allow_nan=True))
+
+
+def _execute(fn: str, kwargs: Mapping[str, Any]) -> tuple[bool, Any, float]:
+    """Worker side: ``(ok, output or error text, seconds)``; never raises."""
+    t0 = time.perf_counter()
+    try:
+        out = call_job(fn, kwargs)
+        return True, out, time.perf_counter() - t0
+    except BaseException as exc:  # noqa: BLE001 - a job's failure is data, reported
+        if isinstance(exc, KeyboardInterrupt):
+            raise
+        text = "".join(traceback.format_exception_only(type(exc), exc)).strip()
+        detail = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
+        return False, {"error": text, "traceback": detail}, time.perf_counter() - t0
+
+
+_CACHE: dict[Any, Any] = {}
+
+
+def worker_cache(key: Any, make: Callable[[], Any], limit: int = 4) -> Any:
+    """Something expensive to build (an env, a loaded atlas), kept for the worker's next jobs.
+
+    Only for things whose use does not depend on what was done with them before (an
+    env whose ``reset(seed=...)`` fully determines the episode); the oldest entries
+    are closed (if they have ``close``) when more than ``limit`` are kept.
+    """
+    if key in _CACHE:
+        return _CACHE[key]
+    while len(_CACHE) >= limit:
+        old = _CACHE.pop(next(iter(_CACHE)))
+        close = getattr(old, "close", None)
+        if callable(close):
+            close()
+    _CACHE[key] = value = make()
+    return value
+
+
+def _init_worker() -> None:
+    os.environ.update(SINGLE_THREADED)
+    try:
+        import cv2
+
+        cv2.setNumThreads(1)
+    except ImportError:  # pragma: no cover - OpenCV is a dependency
+        pass
+
+
+# --------------------------------------------------------------------------- backends
+class LocalBackend:
+    """Jobs in a pool of ``workers`` processes on this machine (1: in this process).
+
+    A worker that dies (killed by the OOM killer, a crash in native code) fails the
+    jobs it was running, which are then retried on a fresh pool; it never hangs the run.
+    """
+
+    name = "local"
+
+    def __init__(self, workers: int = 2):
+        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+            raise ValueError(f"workers must be an int >= 1, got {workers!r}")
+        self.workers = workers
+
+    def describe(self) -> dict[str, Any]:
+        return {"backend": self.name, "workers": self.workers}
+
+    def run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
+        """Yield ``(index, ok, output or error, seconds)`` as jobs finish."""
+        if self.workers == 1:
+            for i, job in enumerate(jobs):
+                yield (i, *_execute(job.fn, job.kwargs))
+            return
+        yield from self._pool_run(jobs)
+
+    def _pool_run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
+        queue = list(range(len(jobs)))[::-1]
+        ctx = mp.get_context("spawn")
+        saved = {k: os.environ.get(k) for k in SINGLE_THREADED}
+        os.environ.update(SINGLE_THREADED)  # spawned workers read it when numpy loads
+        try:
+            while queue:
+                pool = cf.ProcessPoolExecutor(
+                    self.workers, mp_context=ctx, initializer=_init_worker
+                )
+                running: dict[cf.Future, int] = {}
+                broken = False
+                try:
+                    while queue or running:
+                        # at most one job per worker in flight: a dead worker then
+                        # fails only the jobs that were really running
+                        while queue and len(running) < self.workers and not broken:
+                            i = queue.pop()
+                            running[pool.submit(_execute, jobs[i].fn, jobs[i].kwargs)] = i
+                        done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+                        for fut in done:
+                            i = running.pop(fut)
+                            try:
+                                yield (i, *fut.result())
+                            except BrokenProcessPool:
+                                broken = True
+                                msg = (
+                                    "the worker process died while running this job "
+                                    "(killed, out of memory, or a crash in native code)"
+                                )
+                                yield i, False, {"error": msg, "traceback": msg}, math.nan
+                        if broken and not running:
+                            break
+                finally:
+                    pool.shutdown(wait=not broken, cancel_futures=True)
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
+
+
+class RayBackend:
+    """Jobs as Ray tasks: on an existing cluster (``address``) or a local Ray instance.
+
+    Needs the optional ``cluster`` extra (``pip install "vc_gym[cluster]"``). Every
+    node must have vc_gym installed (and any module a job names, such as a user's
+    tracker factory). A task whose worker dies is reported as a failed attempt.
+
+    Parameters
+    ----------
+    address : str, optional
+        ``"ray://host:10001"``, ``"host:6379"`` or ``"auto"`` to join a running
+        cluster; ``None`` starts a local instance with ``workers`` CPUs.
+    workers : int, optional
+        CPUs of the local instance (default: all of this machine's).
+    """
+
+    name = "ray"
+
+    def __init__(self, address: str | None = None, workers: int | None = None):
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            raise ValueError("the ray backend needs Ray: pip install 'vc_gym[cluster]'") from None
+        if workers is not None and (isinstance(workers, bool) or workers < 1):
+            raise ValueError(f"workers must be an int >= 1, got {workers!r}")
+        self.address = address
+        self.workers = workers
+
+    def describe(self) -> dict[str, Any]:
+        import ray
+
+        return {
+            "backend": self.name,
+            "workers": self.workers,
+            "cluster": "existing" if self.address else "local",
+            "ray": ray.__version__,
+        }
+
+    def run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
+        import ray
+
+        started = False
+        if not ray.is_initialized():
+            kwargs: dict[str, Any] = {
+                "include_dashboard": False,
+                "logging_level": "ERROR",
+                "log_to_driver": False,
+                "runtime_env": {"env_vars": dict(SINGLE_THREADED)},
+            }
+            if self.address:
+                ray.init(address=self.address, **kwargs)
+            else:
+                ray.init(num_cpus=self.workers or os.cpu_count(), **kwargs)
+            started = True
+        try:
+            task = ray.remote(num_cpus=1, max_retries=0)(_ray_execute)
+            refs = {task.remote(job.fn, dict(job.kwargs)): i for i, job in enumerate(jobs)}
+            pending = list(refs)
+            while pending:
+                done, pending = ray.wait(pending, num_returns=1)
+                for ref in done:
+                    i = refs[ref]
+                    try:
+                        yield (i, *ray.get(ref))
+                    except ray.exceptions.RayError as exc:
+                        msg = f"the Ray task failed ({type(exc).__name__}: {exc})"
+                        yield i, False, {"error": msg.splitlines()[0], "traceback": msg}, math.nan
+        finally:
+            if started:
+                ray.shutdown()
+
+
+def _ray_execute(fn: str, kwargs: dict[str, Any]) -> tuple[bool, Any, float]:
+    _init_worker()
+    return _execute(fn, kwargs)
+
+
+def make_backend(
+    name: str = "local", workers: int | None = None, address: str | None = None
+) -> LocalBackend | RayBackend:
+    """A backend by name: ``"local"`` (default 2 workers) or ``"ray"``."""
+    if name == "local":
+        if address:
+            raise ValueError("--address is for the ray backend")
+        return LocalBackend(2 if workers is None else workers)
+    if name == "ray":
+        return RayBackend(address, workers)
+    raise ValueError(f"unknown backend {name!r}; choose from {BACKENDS}")
+
+
+# --------------------------------------------------------------------------- the run
+def check_out_dir(path: str | os.PathLike) -> Path:
+    """Make sure ``path`` is (or can become) a writable folder, before any work starts."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out}: exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".write-test-{os.getpid()}"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
+    return out
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of Python and the packages whose behaviour the figures depend on."""
+    from importlib import metadata
+
+    versions = {"python": platform.python_version()}
+    for dist in ("vc_gym", "numpy", "opencv-python", "pybullet", "gymnasium", "ray"):
+        try:
+            versions[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            continue
+    return versions
+
+
+class ExperimentRun:
+    """The output folder of one experiment: jobs saved as they finish, resumable.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        The folder (created; checked writable before any work).
+    experiment : str
+        Its name (recorded in both JSON files).
+    backend : LocalBackend or RayBackend
+        Who runs the jobs.
+    settings : mapping
+        The experiment's settings (seed, size, ...): written to ``results.json``; a run
+        resumed in the same folder must have the same settings.
+    progress : bool
+        Show a progress bar per stage.
+    retries : int
+        Extra attempts of a job that failed (default 1: retried once).
+    """
+
+    def __init__(
+        self,
+        out_dir: str | os.PathLike,
+        experiment: str,
+        backend: LocalBackend | RayBackend,
+        settings: Mapping[str, Any],
+        progress: bool = True,
+        retries: int = 1,
+    ):
+        self.out = check_out_dir(out_dir)
+        self.experiment = experiment
+        self.backend = backend
+        self.settings = json.loads(json.dumps(dict(settings)))
+        self.progress = progress
+        self.retries = int(retries)
+        self.failures: list[dict[str, Any]] = []
+        self.stages: dict[str, dict[str, Any]] = {}
+        self.timings: dict[str, dict[str, Any]] = {}
+        self._t0 = time.perf_counter()
+        self._check_settings()
+
+    def _check_settings(self) -> None:
+        marker = self.out / "jobs" / "settings.json"
+        mine = {"experiment": self.experiment, **self.settings}
+        if marker.is_file():
+            try:
+                theirs = json.loads(marker.read_text())
+            except (OSError, ValueError):
+                theirs = None
+            if theirs != mine:
+                raise ValueError(
+                    f"{self.out} holds the jobs of another run ({theirs}); resume it with the "
+                    "same settings or choose another --out"
+                )
+        else:
+            write_json(marker, mine)
+
+    def job_file(self, stage: str, key: str) -> Path:
+        return self.out / "jobs" / stage / f"{key}.json"
+
+    def _saved(self, stage: str, job: Job) -> JobOutcome | None:
+        path = self.job_file(stage, job.key)
+        if not path.is_file():
+            return None
+        try:
+            rec = json.loads(path.read_text())
+        except (OSError, ValueError):
+            return None  # a torn or foreign file: run the job again
+        if not isinstance(rec, dict) or not rec.get("ok"):
+            return None  # failed last time: try again
+        if rec.get("fn") != job.fn or rec.get("kwargs") != json.loads(json.dumps(job.kwargs)):
+            raise ValueError(f"{path} was written by a job with other arguments; use another --out")
+        return JobOutcome(
+            job.key,
+            True,
+            rec["output"],
+            None,
+            rec.get("attempts", 1),
+            rec.get("seconds"),
+            resumed=True,
+        )
+
+    def run(self, stage: str, jobs: Sequence[Job]) -> list[dict[str, Any] | None]:
+        """Run the jobs of one stage; return their outputs in job order.
+
+        The ``timing`` entry of each output is moved to ``run.json``. A job that failed
+        after its retries gives ``None`` and is listed in :attr:`failures`.
+        """
+        keys = [j.key for j in jobs]
+        if len(set(keys)) != len(keys):
+            raise ValueError(f"stage {stage!r}: job keys are not unique")
+        outcomes: dict[str, JobOutcome] = {}
+        todo = []
+        for job in jobs:
+            saved = self._saved(stage, job)
+            if saved is None:
+                todo.append(job)
+            else:
+                outcomes[job.key] = saved
+        t0 = time.perf_counter()
+        attempts = {j.key: 0 for j in todo}
+        retried = 0
+        with tqdm(
+            total=len(jobs),
+            initial=len(outcomes),
+            desc=f"{self.experiment}: {stage}",
+            unit="job",
+            disable=not self.progress or not jobs,
+        ) as bar:
+            round_jobs = todo
+            while round_jobs:
+                again = []
+                for i, ok, out, seconds in self.backend.run(round_jobs):
+                    job = round_jobs[i]
+                    attempts[job.key] += 1
+                    if ok:
+                        outcome = JobOutcome(job.key, True, out, None, attempts[job.key], seconds)
+                    elif attempts[job.key] <= self.retries:
+                        again.append(job)
+                        retried += 1
+                        continue
+                    else:
+                        outcome = JobOutcome(
+                            job.key, False, None, out["error"], attempts[job.key], seconds
+                        )
+                    self._save(stage, job, outcome, out)
+                    outcomes[job.key] = outcome
+                    bar.update()
+                round_jobs = again
+        wall = time.perf_counter() - t0
+        ran = [o for o in outcomes.values() if not o.resumed]
+        secs = sorted(o.seconds for o in ran if o.seconds is not None and math.isfinite(o.seconds))
+        self.stages[stage] = {
+            "jobs": len(jobs),
+            "ran": len(ran),
+            "resumed": len(jobs) - len(ran),
+            "failed": sum(not o.ok for o in outcomes.values()),
+            "retried": retried,
+            "wall_s": round(wall, 3),
+            "jobs_per_s": round(len(ran) / wall, 4) if ran and wall > 0 else None,
+            "job_s_median": round(secs[len(secs) // 2], 4) if secs else None,
+        }
+        results: list[dict[str, Any] | None] = []
+        stage_timing: dict[str, Any] = {}
+        for job in jobs:
+            o = outcomes[job.key]
+            if not o.ok:
+                self.failures.append(
+                    {"stage": stage, "key": job.key, "attempts": o.attempts, "error": o.error}
+                )
+                results.append(None)
+                continue
+            out = dict(o.output or {})
+            timing = out.pop(TIMING, None)
+            if timing is not None:
+                stage_timing[job.key] = timing
+            results.append(out)
+        if stage_timing:
+            self.timings[stage] = stage_timing
+        return results
+
+    def _save(self, stage: str, job: Job, outcome: JobOutcome, out: Any) -> None:
+        rec = {
+            "key": job.key,
+            "fn": job.fn,
+            "kwargs": dict(job.kwargs),
+            "ok": outcome.ok,
+            "attempts": outcome.attempts,
+            "seconds": outcome.seconds if outcome.seconds == outcome.seconds else None,
+            "output": outcome.output,
+        }
+        if not outcome.ok:
+            rec["error"] = outcome.error
+            rec["traceback"] = out.get("traceback")
+        write_json(self.job_file(stage, job.key), rec)
+
+    def finish(
+        self, results: Mapping[str, Any], run_info: Mapping[str, Any] | None = None
+    ) -> dict[str, Any]:
+        """Write ``results.json`` (figures + failed jobs) and ``run.json`` (timings).
+
+        Returns the results as written.
+        """
+        doc = {
+            "experiment": self.experiment,
+            "settings": self.settings,
+            **dict(results),
+            "failed_jobs": list(self.failures),
+        }
+        doc = json.loads(json.dumps(doc, allow_nan=True))
+        write_json(self.out / "results.json", doc)
+        run = {
+            "experiment": self.experiment,
+            **self.backend.describe(),
+            "duration_s": round(time.perf_counter() - self._t0, 2),
+            "stages": self.stages,
+            "versions": package_versions(),
+            **dict(run_info or {}),
+            "job_timings": self.timings,
+        }
+        write_json(self.out / "run.json", run)
+        return doc
