@@ -32,9 +32,10 @@ def square_jobs(n, log=None, sleep_s=0.0):
 
 
 def run_squares(out, workers, n=6, **kwargs):
-    run = ExperimentRun(out, "toy", LocalBackend(workers), {"n": n}, progress=False)
-    outs = run.run("squares", square_jobs(n, **kwargs))
-    return run, outs, run.finish({"squares": [o["square"] for o in outs]})
+    with LocalBackend(workers) as backend:
+        run = ExperimentRun(out, "toy", backend, {"n": n}, progress=False)
+        outs = run.run("squares", square_jobs(n, **kwargs))
+        return run, outs, run.finish({"squares": [o["square"] for o in outs]})
 
 
 @pytest.mark.parametrize("workers", [1, 2])
@@ -111,10 +112,11 @@ def test_a_failing_job_is_retried_once_then_reported(tmp_path):
 
 
 def test_a_dead_worker_fails_its_job_not_the_run(tmp_path):
-    run = ExperimentRun(tmp_path, "toy", LocalBackend(2), {}, progress=False)
     jobs = [Job("dies", f"{JOBS}:die", {}), *square_jobs(4)]
     t0 = time.monotonic()
-    outs = run.run("mixed", jobs)
+    with LocalBackend(2) as backend:
+        run = ExperimentRun(tmp_path, "toy", backend, {}, progress=False)
+        outs = run.run("mixed", jobs)
     assert time.monotonic() - t0 < 90
     assert outs[0] is None and [o["square"] for o in outs[1:]] == [0, 1, 4, 9]
     (failure,) = run.failures

@@ -192,9 +192,16 @@ class LocalBackend:
         if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
             raise ValueError(f"workers must be an int >= 1, got {workers!r}")
         self.workers = workers
+        self._executor: cf.ProcessPoolExecutor | None = None
 
     def describe(self) -> dict[str, Any]:
         return {"backend": self.name, "workers": self.workers}
+
+    def __enter__(self) -> LocalBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
         """Yield ``(index, ok, output or error, seconds)`` as jobs finish."""
@@ -204,47 +211,64 @@ class LocalBackend:
             return
         yield from self._pool_run(jobs)
 
+    def _pool(self) -> cf.ProcessPoolExecutor:
+        if self._executor is None:
+            saved = {k: os.environ.get(k) for k in SINGLE_THREADED}
+            os.environ.update(SINGLE_THREADED)  # spawned workers read it when numpy loads
+            try:
+                self._executor = cf.ProcessPoolExecutor(
+                    self.workers, mp_context=mp.get_context("spawn"), initializer=_init_worker
+                )
+                # start the workers now, while the environment is single-threaded
+                list(self._executor.map(_noop, range(self.workers)))
+            finally:
+                for k, v in saved.items():
+                    if v is None:
+                        os.environ.pop(k, None)
+                    else:
+                        os.environ[k] = v
+        return self._executor
+
+    def close(self) -> None:
+        """Stop the worker processes (a later :meth:`run` starts new ones)."""
+        if self._executor is not None:
+            self._executor.shutdown(wait=True, cancel_futures=True)
+            self._executor = None
+
     def _pool_run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
         queue = list(range(len(jobs)))[::-1]
-        ctx = mp.get_context("spawn")
-        saved = {k: os.environ.get(k) for k in SINGLE_THREADED}
-        os.environ.update(SINGLE_THREADED)  # spawned workers read it when numpy loads
-        try:
-            while queue:
-                pool = cf.ProcessPoolExecutor(
-                    self.workers, mp_context=ctx, initializer=_init_worker
-                )
-                running: dict[cf.Future, int] = {}
-                broken = False
+        running: dict[cf.Future, int] = {}
+        while queue or running:
+            pool = self._pool()
+            # at most one job per worker in flight: a dead worker then fails only the
+            # jobs that were really running
+            while queue and len(running) < self.workers:
+                i = queue.pop()
+                running[pool.submit(_execute, jobs[i].fn, jobs[i].kwargs)] = i
+            done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+            broken = False
+            for fut in done:
+                i = running.pop(fut)
                 try:
-                    while queue or running:
-                        # at most one job per worker in flight: a dead worker then
-                        # fails only the jobs that were really running
-                        while queue and len(running) < self.workers and not broken:
-                            i = queue.pop()
-                            running[pool.submit(_execute, jobs[i].fn, jobs[i].kwargs)] = i
-                        done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
-                        for fut in done:
-                            i = running.pop(fut)
-                            try:
-                                yield (i, *fut.result())
-                            except BrokenProcessPool:
-                                broken = True
-                                msg = (
-                                    "the worker process died while running this job "
-                                    "(killed, out of memory, or a crash in native code)"
-                                )
-                                yield i, False, {"error": msg, "traceback": msg}, math.nan
-                        if broken and not running:
-                            break
-                finally:
-                    pool.shutdown(wait=not broken, cancel_futures=True)
-        finally:
-            for k, v in saved.items():
-                if v is None:
-                    os.environ.pop(k, None)
-                else:
-                    os.environ[k] = v
+                    yield (i, *fut.result())
+                except BrokenProcessPool:
+                    broken = True
+                    msg = (
+                        "the worker process died while running this job "
+                        "(killed, out of memory, or a crash in native code)"
+                    )
+                    yield i, False, {"error": msg, "traceback": msg}, math.nan
+            if broken:  # every job still running failed with it: start a new pool
+                for fut, i in list(running.items()):
+                    running.pop(fut)
+                    msg = "the pool broke (another worker died) while this job ran"
+                    yield i, False, {"error": msg, "traceback": msg}, math.nan
+                self._executor.shutdown(wait=False, cancel_futures=True)
+                self._executor = None
+
+
+def _noop(_: int) -> None:
+    return None
 
 
 class RayBackend:
@@ -274,6 +298,7 @@ class RayBackend:
             raise ValueError(f"workers must be an int >= 1, got {workers!r}")
         self.address = address
         self.workers = workers
+        self._started = False
 
     def describe(self) -> dict[str, Any]:
         import ray
@@ -285,26 +310,46 @@ class RayBackend:
             "ray": ray.__version__,
         }
 
-    def run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
+    def _start(self) -> None:
         import ray
 
-        started = False
-        if not ray.is_initialized():
-            kwargs: dict[str, Any] = {
-                "include_dashboard": False,
-                "logging_level": "ERROR",
-                "log_to_driver": False,
-                "runtime_env": {"env_vars": dict(SINGLE_THREADED)},
-            }
-            if self.address:
-                ray.init(address=self.address, **kwargs)
-            else:
-                ray.init(num_cpus=self.workers or os.cpu_count(), **kwargs)
-            started = True
+        if ray.is_initialized():
+            return
+        kwargs: dict[str, Any] = {
+            "include_dashboard": False,
+            "logging_level": "ERROR",
+            "log_to_driver": False,
+            "runtime_env": {"env_vars": dict(SINGLE_THREADED)},
+        }
+        if self.address:
+            ray.init(address=self.address, **kwargs)
+        else:
+            ray.init(num_cpus=self.workers or os.cpu_count(), **kwargs)
+        self._started = True
+
+    def close(self) -> None:
+        """Shut Ray down if this backend started it."""
+        if self._started:
+            import ray
+
+            ray.shutdown()
+            self._started = False
+
+    def __enter__(self) -> RayBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
+        """Yield ``(index, ok, output or error, seconds)`` as jobs finish."""
+        import ray
+
+        self._start()
+        task = ray.remote(num_cpus=1, max_retries=0)(_ray_execute)
+        refs = {task.remote(job.fn, dict(job.kwargs)): i for i, job in enumerate(jobs)}
+        pending = list(refs)
         try:
-            task = ray.remote(num_cpus=1, max_retries=0)(_ray_execute)
-            refs = {task.remote(job.fn, dict(job.kwargs)): i for i, job in enumerate(jobs)}
-            pending = list(refs)
             while pending:
                 done, pending = ray.wait(pending, num_returns=1)
                 for ref in done:
@@ -315,8 +360,8 @@ class RayBackend:
                         msg = f"the Ray task failed ({type(exc).__name__}: {exc})"
                         yield i, False, {"error": msg.splitlines()[0], "traceback": msg}, math.nan
         finally:
-            if started:
-                ray.shutdown()
+            for ref in pending:  # interrupted: do not leave tasks running
+                ray.cancel(ref, force=True)
 
 
 def _ray_execute(fn: str, kwargs: dict[str, Any]) -> tuple[bool, Any, float]:
@@ -384,6 +429,8 @@ class ExperimentRun:
         Show a progress bar per stage.
     retries : int
         Extra attempts of a job that failed (default 1: retried once).
+    owns_backend : bool
+        Close the backend (stop its workers) in :meth:`finish`.
     """
 
     def __init__(
@@ -394,8 +441,10 @@ class ExperimentRun:
         settings: Mapping[str, Any],
         progress: bool = True,
         retries: int = 1,
+        owns_backend: bool = False,
     ):
         self.out = check_out_dir(out_dir)
+        self.owns_backend = owns_backend
         self.experiment = experiment
         self.backend = backend
         self.settings = json.loads(json.dumps(dict(settings)))
@@ -567,4 +616,6 @@ class ExperimentRun:
             "job_timings": self.timings,
         }
         write_json(self.out / "run.json", run)
+        if self.owns_backend:
+            self.backend.close()
         return doc
