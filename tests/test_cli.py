@@ -28,8 +28,8 @@ def test_console_script_is_installed():
 
 
 def test_synthetic_compass_writes_summary_and_plot(tmp_path, capsys):
-    assert main(["experiment", "synthetic-compass", "--out-dir", str(tmp_path), "--seed", "3"]) == 0
-    summary = json.loads((tmp_path / "synthetic_compass.json").read_text())
+    assert main(["experiment", "synthetic-compass", "--out", str(tmp_path), "--seed", "3"]) == 0
+    summary = json.loads((tmp_path / "results.json").read_text())
     assert set(summary["results"]) == {
         "room/exposure=none",
         "room/exposure=mean",

@@ -30,30 +30,15 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.evaluate import evaluate_agent
-
-    result = evaluate_agent(
-        agent=args.agent,
-        tracker=args.tracker,
-        episodes=args.episodes,
-        seed=args.seed,
-        learn_time_s=args.learn_time,
-        relearn=args.relearn,
-        max_homing_s=args.max_homing,
-        workers=args.workers,
-        out_dir=args.out,
-        progress=not args.json,
-    )
-    if args.json:
-        print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
-    else:
-        print(
-            f"{result['episodes']} episodes: mean stop offset {result['mean_stop_offset_cm']} cm, "
-            f"std {result['std_stop_offset_cm']} cm, mean distance "
-            f"{result['mean_stop_distance_cm']} cm, success {result['success_rate']:.0%} "
-            f"(paper: mean (-22, 12) cm, std (17, 15) cm)"
-        )
-    return 0
+    """``vc-gym evaluate``: the homing experiment without the likelihood field."""
+    args.name = "homing"
+    args.field = False
+    args.seeds = None
+    args.tracker = [args.tracker]
+    args.atlas = args.video = args.address = args.size = None
+    args.quick = False
+    args.backend = "local"
+    return _cmd_experiment(args)
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
@@ -150,11 +135,89 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
+    if args.name in ("synthetic-compass", "real-rotation"):
+        return _cmd_compass_experiment(args)
+    from vc_gym.experiments.runner import check_out_dir, make_backend
+    from vc_gym.experiments.studies import ExperimentOptions, get_experiment
+
+    experiment = get_experiment(args.name)
+    size = "quick" if args.quick else (args.size or "full")
+    out = check_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}")
+    run = experiment.runner()
+    options = _experiment_options(args, run)
+    with make_backend(args.backend, args.workers, args.address) as backend:
+        opts = ExperimentOptions(
+            seed=args.seed,
+            size=size,
+            backend=backend,
+            atlas_dir=args.atlas,
+            video=args.video or 0,
+            progress=not args.json,
+        )
+        results = run(out, opts, **options)
+    if args.json:
+        print(json.dumps({k: v for k, v in results.items() if k != "per_episode"}))
+    else:
+        for line in experiment.summary_lines(results):
+            print(line)
+        print(f"wrote {out / 'results.json'}, {out / 'run.json'} and the plots in {out}")
+    failed = results.get("failed_jobs") or []
+    if failed:
+        print(
+            f"vc-gym {args.command}: failed: {len(failed)} job(s) failed twice, e.g. "
+            f"{failed[0]['stage']}/{failed[0]['key']}: {failed[0]['error']} (all in "
+            f"{out / 'results.json'}; rerun the same command to retry them)",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
+
+
+def _experiment_options(args: argparse.Namespace, run) -> dict:
+    """The experiment-specific flags given, checked against what ``run`` accepts."""
+    import inspect
+
+    accepted = inspect.signature(run).parameters
+    given = {
+        "agent": getattr(args, "agent", None),
+        "episodes": getattr(args, "episodes", None),
+        "seeds": getattr(args, "seeds", None),
+        "scenes": getattr(args, "scenes", None),
+        "learn_time_s": getattr(args, "learn_time", None),
+        "max_homing_s": getattr(args, "max_homing", None),
+        "relearn": getattr(args, "relearn", None),
+        "field": getattr(args, "field", None),
+    }
+    trackers = getattr(args, "tracker", None)
+    if trackers:
+        if "trackers" in accepted:
+            given["trackers"] = trackers
+        elif len(trackers) > 1:
+            raise ValueError(f"experiment {args.name} takes one --tracker")
+        else:
+            given["tracker"] = trackers[0]
+    options = {}
+    for name, value in given.items():
+        if value is None:
+            continue
+        if name not in accepted:
+            flag = "--" + {"learn_time_s": "learn-time", "max_homing_s": "max-homing"}.get(
+                name, name
+            )
+            raise ValueError(f"experiment {args.name} does not take {flag}")
+        options[name] = value
+    return options
+
+
+def _cmd_compass_experiment(args: argparse.Namespace) -> int:
+    """The compass-only experiments (no simulator, no jobs)."""
+    from vc_gym.experiments.runner import check_out_dir
+
+    out = check_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}")
     if args.name == "synthetic-compass":
         from vc_gym.experiments.synthetic_compass import run_synthetic_compass
 
-        out_dir = args.out_dir or "vc_gym_synthetic"
-        result = run_synthetic_compass(out_dir, seed=args.seed)
+        result = run_synthetic_compass(out, seed=args.seed)  # writes results.json
         if not args.json:
             for label, entry in result["results"].items():
                 parts = [
@@ -163,8 +226,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
                     for k, v in entry.items()
                 ]
                 print(f"{label:28s} " + " | ".join(parts))
-            print(f"wrote {Path(out_dir) / 'synthetic_compass.png'}")
-    elif args.name == "real-rotation":
+            print(f"wrote {out / 'synthetic_compass.png'}")
+    else:
         from vc_gym.experiments.real_data import default_real_data_dir
         from vc_gym.experiments.real_rotation import run_real_rotation
 
@@ -184,10 +247,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
                     f"{r['set']:22s} {r['n_colors']:7d} {r['exposure']:>8s} "
                     f"{r['median_error_deg']:7.2f}° {r['within_5deg']:5.0%}"
                 )
-    else:  # pragma: no cover
-        raise AssertionError(args.name)
-    if args.out:
-        write_json(args.out, result)
+        write_json(out / "results.json", result)
     if args.json:
         print(json.dumps(result))
     return 0
@@ -237,6 +297,19 @@ def _tracker_spec(text: str) -> object:
             raise argparse.ArgumentTypeError("a JSON tracker spec must be an object")
         return spec
     return text
+
+
+def _int_list(text: str) -> list[int]:
+    try:
+        return [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected integers separated by commas: {text!r}"
+        ) from None
+
+
+def _str_list(text: str) -> list[str]:
+    return [v.strip() for v in text.split(",") if v.strip()]
 
 
 def _add_tracker_option(p: argparse.ArgumentParser) -> None:
@@ -328,8 +401,10 @@ def build_parser() -> argparse.ArgumentParser:
             "EPISODES times (seeds SEED+1, ...) and walks home with the scripted agent or a "
             "trained one (--agent DIR/model.zip from vc-gym train); it must stand still 5 s "
             "to stop. Reports the stop positions: mean and standard deviation per axis "
-            "(paper: (-22, +12) cm and (17, 15) cm), mean distance and success rate. With "
-            "--out, writes DIR/evaluation.json and DIR/stop_positions.png."
+            "(paper: (-22, +12) cm and (17, 15) cm), mean distance and success rate. It is "
+            "'vc-gym experiment homing' without the likelihood field: writes "
+            "DIR/results.json, DIR/run.json and DIR/stop_positions.png, and resumes an "
+            "interrupted run in the same DIR."
         ),
     )
     p.add_argument(
@@ -359,9 +434,11 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help="homing seconds before an episode ends as timed out",
     )
-    p.add_argument("--workers", type=int, default=2, help="parallel processes")
+    p.add_argument("--workers", type=int, default=2, help="parallel processes (1: in this process)")
     _add_tracker_option(p)
-    p.add_argument("--out", metavar="DIR", help="folder for evaluation.json and the plot")
+    p.add_argument(
+        "--out", default="vc_gym_homing", metavar="DIR", help="output folder (resumable)"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_evaluate)
 
@@ -421,25 +498,83 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--randomize", action="store_true", help="domain-randomised scene")
     p.set_defaults(func=_cmd_render)
 
+    from vc_gym.experiments.studies import EXPERIMENTS, SIZES
+
+    listing = "; ".join(f"{name}: {e.help}" for name, e in EXPERIMENTS.items())
     p = sub.add_parser(
         "experiment",
-        help="the paper's experiments and evaluations on real data",
+        help="the paper's experiments, the tracker benchmark, and evaluations on real data",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         description=(
-            "real-rotation: learn from 9 alternate photos of a camera turning in place and "
-            "estimate the yaw of crops of the other 9, for the indoor and outdoor sets, with "
-            "10 and 3 colour classes, without and with exposure normalisation. "
-            "synthetic-compass: learn synthetic room and outdoor panoramas (8 x 45 deg with "
-            "head pans) and estimate random headings at normal and half illumination."
+            "Experiments split into independent jobs run by a backend (a local process pool "
+            "or Ray) and saved as they finish: rerunning the same command in the same --out "
+            "resumes an interrupted run. Each writes DIR/results.json (figures only: the same "
+            "seed gives the same bytes on any backend), DIR/run.json (timings, jobs per "
+            "second, backend, versions) and its plots. Learned atlases are saved in "
+            "DIR/atlases and reused by every job.\n\n"
+            + listing
+            + "; real-rotation: learn from 9 alternate photos of a camera turning in place "
+            "and estimate the yaw of crops of the other 9 (indoor and outdoor sets, 10 and 3 "
+            "colour classes, without and with exposure normalisation); synthetic-compass: "
+            "synthetic room and outdoor panoramas at normal and half illumination."
         ),
     )
-    p.add_argument("name", choices=["real-rotation", "synthetic-compass"], help="which experiment")
-    p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
     p.add_argument(
-        "--out-dir", metavar="DIR", help="synthetic-compass: folder for the JSON and the plot"
+        "name",
+        choices=[*EXPERIMENTS, "real-rotation", "synthetic-compass"],
+        help="which experiment",
     )
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", metavar="DIR", help="output folder (default: vc_gym_NAME)")
+    p.add_argument("--seed", type=int, default=0, help="base seed of every random draw")
+    p.add_argument(
+        "--quick", action="store_true", help="the small size the tests use (= --size quick)"
+    )
+    p.add_argument(
+        "--size",
+        choices=SIZES,
+        help="quick (tests), paper (the report's size), full (default)",
+    )
+    p.add_argument("--backend", choices=["local", "ray"], default="local", help="who runs the jobs")
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="local: worker processes (default 2; 1 runs in this process); ray: CPUs of "
+        "the local Ray instance",
+    )
+    p.add_argument(
+        "--address",
+        metavar="ADDR",
+        help="ray: join this running cluster ('auto', 'host:6379' or 'ray://host:10001') "
+        "instead of starting a local instance",
+    )
+    p.add_argument("--atlas", metavar="DIR", help="reuse the saved atlases in DIR")
+    p.add_argument(
+        "--video", type=int, metavar="N", help="write the first N homing episodes as MP4"
+    )
+    p.add_argument(
+        "--agent",
+        metavar="scripted|pretrained|DIR/model.zip",
+        help="homing, trackers: the agent (default scripted)",
+    )
+    p.add_argument(
+        "--tracker",
+        action="append",
+        type=_tracker_spec,
+        metavar="SPEC",
+        help="the tracker (homing) or the trackers to compare (trackers; repeat the flag): "
+        "grid, particle, kalman, 'package.module:factory' or a JSON object",
+    )
+    p.add_argument("--episodes", type=int, help="kidnappings per learning seed (paper: 33)")
+    p.add_argument(
+        "--seeds", type=_int_list, metavar="S,S,...", help="learning seeds (default: --seed)"
+    )
+    p.add_argument(
+        "--scenes", type=_str_list, metavar="NAME,...", help="scenes (default by experiment)"
+    )
+    p.add_argument("--learn-time", type=float, help="seconds per learning direction")
+    p.add_argument("--max-homing", type=float, metavar="S", help="homing time limit")
+    p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
-    p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
     p.set_defaults(func=_cmd_experiment)
     return parser
 

@@ -98,6 +98,22 @@ def test_exposure_reference_survives_save_load(tmp_path, room_pano, make_learned
     )
 
 
+def test_compasses_sharing_exposure_normalised_colours_learn_and_localise(
+    tmp_path, room_pano, make_learned_compass
+):
+    # the learners fit colours once and give them to every spot's compass; the
+    # exposure reference must travel with the classes (it used to be lost: gain 0)
+    first = make_learned_compass(room_pano, CompassConfig(exposure="mean", n_colors=4))
+    assert first.colors.exposure_reference > 0
+    second = VisualCompass(first.config, first.colors)
+    for yaw in range(0, 360, 30):
+        second.learn(render_view(room_pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
+    img = render_view(room_pano, Camera(yaw_deg=200.0), illumination=0.5)
+    assert abs(wrap180(second.estimate(img, Camera()).heading_deg - 200.0)) < 5.0
+    arrays = first.colors.to_arrays()
+    assert float(arrays["colors_exposure_reference"]) == first.colors.exposure_reference
+
+
 def test_likelihood_shape_and_estimate_fields(room_pano, room_compass):
     img = render_view(room_pano, Camera(yaw_deg=123.0))
     ll = room_compass.log_likelihood(img, Camera())

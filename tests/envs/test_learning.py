@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 
 import vc_gym  # noqa: F401
-from vc_gym.envs.learning import LearningConfig, ScriptedLearner, kidnap_pose
+from vc_gym.angles import wrap180
+from vc_gym.compass import Camera, VisualCompass
+from vc_gym.envs.learning import LearningConfig, ScriptedLearner, SpotLearning, kidnap_pose
 
 
 def test_loop_closure_calibrates_odometry_turns():
@@ -46,3 +48,56 @@ def test_kidnap_pose_lies_inside_the_margin():
 def test_bad_config(bad):
     with pytest.raises(ValueError):
         LearningConfig(**bad)
+
+
+def test_learn_turn_maps_headings_in_the_start_frame():
+    env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+    room = env.unwrapped
+    room.reset(seed=2, options={"pose": (0.5, -0.5, 90.0)})
+    learner = ScriptedLearner(room, LearningConfig(learn_time_s=0.3))
+    with pytest.raises(ValueError, match="steps"):
+        learner.learn_turn(steps=0)
+    compass = learner.learn_turn()
+    assert isinstance(compass, VisualCompass) and compass is learner.home_compass
+    assert len(learner.turn_path) == 8 * 3
+    # a frame taken facing 90° + 40° (world) is 40° in the frame the robot started in
+    obs, _ = room.reset(seed=3, options={"pose": (0.5, -0.5, 130.0)})
+    env.close()
+    est = compass.estimate(obs["image"], Camera(hfov_deg=room.camera.hfov_deg))
+    assert abs(wrap180(est.heading_deg - 40.0)) < 5.0
+
+
+def test_spot_learning_gives_a_one_spot_normalised_atlas():
+    spot = (1.0, 0.5)
+    env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+    room = env.unwrapped
+    room.reset(seed=5)
+    config = LearningConfig(learn_time_s=0.5, normalise_directions=6)
+    result = SpotLearning(spot)(room, config)
+    atlas = result.atlas
+    assert atlas.names == ("spot",) and atlas.home == "spot"
+    assert atlas.positions.tolist() == [list(spot)] and atlas.home_position == spot
+    assert atlas.is_normalized and atlas._home_scores.shape == (6, 1)
+    assert result.spots == {"spot": spot}
+    path = np.array(result.true_path)
+    assert path.shape == (8 * 5, 3) and np.allclose(path[:, :2], spot, atol=0.02)
+    camera = Camera(hfov_deg=room.camera.hfov_deg)
+    for yaw in (17.0, 200.0):
+        obs, _ = room.reset(seed=6, options={"pose": (*spot, yaw)})
+        est = atlas.estimate_position(obs["image"], camera)
+        assert abs(wrap180(est.estimates["spot"].heading_deg - yaw)) < 5.0
+        assert est.goodness["spot"] == pytest.approx(1.0, abs=0.05)
+    # pure per call: the same seed on the reused room learns the same atlas
+    room.reset(seed=5)
+    again = SpotLearning(spot)(room, config)
+    env.close()
+    for a, b in zip(atlas.compasses, again.atlas.compasses, strict=True):
+        for key, arr in a.to_arrays().items():
+            np.testing.assert_array_equal(arr, b.to_arrays()[key])
+    np.testing.assert_array_equal(atlas._home_scores, again.atlas._home_scores)
+
+
+@pytest.mark.parametrize("bad", [(1.0,), (0.0, float("nan")), "ab", None])
+def test_spot_learning_rejects_bad_spots(bad):
+    with pytest.raises(ValueError, match="spot"):
+        SpotLearning(bad)

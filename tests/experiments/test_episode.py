@@ -9,14 +9,19 @@ import pytest
 
 from vc_gym.experiments.demo import run_demo
 from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
-from vc_gym.experiments.evaluate import evaluate_agent
+from vc_gym.experiments.runner import LocalBackend
+from vc_gym.experiments.studies import ExperimentOptions
+from vc_gym.experiments.studies.homing import run_homing
 
 SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
 
 
 def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
     demo = run_demo(tmp_path, seed=2, progress=False, **SHORT)
-    evaluation = evaluate_agent(episodes=1, seed=2, workers=1, progress=False, **SHORT)
+    # the experiment learns the place in a job, saves the atlas and homes with the
+    # loaded atlas: the same episode, so the atlas file is an exact round trip
+    opts = ExperimentOptions(seed=2, backend=LocalBackend(1), progress=False)
+    evaluation = run_homing(tmp_path / "homing", opts, episodes=1, field=False, **SHORT)
     episode = evaluation["per_episode"][0]
     assert episode["seed"] == 3 and demo["learning_seed"] == 2
     assert {k: demo[k] for k in episode} == episode

@@ -9,7 +9,9 @@ import pytest
 
 from vc_gym.agents.learned import LearnedHomingAgent
 from vc_gym.cli import main
-from vc_gym.experiments.evaluate import evaluate_agent
+from vc_gym.experiments.runner import LocalBackend
+from vc_gym.experiments.studies import ExperimentOptions
+from vc_gym.experiments.studies.homing import run_homing
 from vc_gym.experiments.training import TrainConfig, train
 
 TINY = TrainConfig(
@@ -52,24 +54,25 @@ def test_reloaded_model_gives_the_same_actions(trained):
 
 def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
     out, _ = trained
-    r = evaluate_agent(
+    r = run_homing(
+        tmp_path / "homing",
+        ExperimentOptions(seed=1, backend=LocalBackend(1), progress=False),
         agent=str(out / "model.zip"),
         episodes=2,
-        seed=1,
         learn_time_s=0.2,
         max_homing_s=5.0,
-        workers=1,
-        out_dir=tmp_path,
-        progress=False,
+        field=False,
     )
-    assert len(r["per_episode"]) == 2 and r["agent"].endswith("model.zip")
+    assert len(r["per_episode"]) == 2 and r["settings"]["agent"] == out.name
     for ep in r["per_episode"]:
         assert ep["stopped"] or ep["timed_out"] or ep["fell"]
         assert ep["sim_time_s"] <= 5.0 + 1e-6
-    assert (tmp_path / "stop_positions.png").read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "homing" / "stop_positions.png").read_bytes()[:4] == b"\x89PNG"
     code = main(
         [
             "evaluate",
+            "--out",
+            str(tmp_path / "evaluate"),
             "--agent",
             str(out / "model.zip"),
             "--episodes",
@@ -85,7 +88,7 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
     )
     assert code == 0
     result = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
-    assert result["episodes"] == 1 and "per_episode" not in result
+    assert result["overall"]["episodes"] == 1 and "per_episode" not in result
 
 
 @pytest.mark.parametrize(

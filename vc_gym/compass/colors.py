@@ -357,6 +357,10 @@ class ColorClasses:
         w = w / w.sum()
 
         self.n_colors = c
+        #: Mean linear light level of the images the classes were fitted on, when they
+        #: were fitted with exposure normalisation (0: not); every compass sharing
+        #: these classes scales its frames to this level.
+        self.exposure_reference = 0.0
         self.means = mu
         self.covariances = cov
         self.weights = w
@@ -536,6 +540,7 @@ class ColorClasses:
             _PREFIX + "weights": self.weights.copy(),
             _PREFIX + "bits": np.array(self.bits, dtype=np.int64),
             _PREFIX + "n_colors": np.array(self.n_colors, dtype=np.int64),
+            _PREFIX + "exposure_reference": np.array(self.exposure_reference, dtype=np.float64),
         }
 
     @classmethod
@@ -566,6 +571,12 @@ class ColorClasses:
             bits,
             prefix=_PREFIX,
         )
+        ref = arrays.get(_PREFIX + "exposure_reference")  # absent in older files
+        if ref is not None:
+            ref = _real_array(_PREFIX + "exposure_reference", ref, ())
+            if ref < 0:
+                raise ValueError(f"{_PREFIX}exposure_reference must be >= 0, got {float(ref)}")
+            obj.exposure_reference = float(ref)
         return obj
 
     def __repr__(self) -> str:

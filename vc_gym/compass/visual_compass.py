@@ -118,6 +118,7 @@ class VisualCompass:
         if not isinstance(self.config, CompassConfig):
             raise ValueError(f"config must be a CompassConfig, got {type(self.config).__name__}")
         self._colors: ColorClasses | None = None
+        self._exposure_ref = 0.0  # mean linear level of the colour-fitting images
         if colors is not None:
             self._set_colors(colors)
         cfg = self.config
@@ -125,7 +126,6 @@ class VisualCompass:
         self._counts = np.zeros((cfg.n_sectors, c2, cfg.n_bins), dtype=np.float64)
         self._n_obs = np.zeros(cfg.n_sectors, dtype=np.float64)
         self._frames = 0
-        self._exposure_ref = 0.0  # mean linear level of the colour-fitting images
         self._sizes: set[tuple[int, int]] = set()  # (H, W) of the learned frames
         self._tables: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._geom_cache: OrderedDict[tuple, _Geometry] = OrderedDict()
@@ -174,6 +174,8 @@ class VisualCompass:
                 f"{self.config.n_colors}"
             )
         self._colors = colors
+        if colors.exposure_reference > 0:  # fitted with exposure normalisation
+            self._exposure_ref = colors.exposure_reference
 
     def fit_colors(
         self,
@@ -213,6 +215,7 @@ class VisualCompass:
         images = [check_image(im, f"images[{i}]") for i, im in enumerate(images)]
         if not images:
             raise ValueError("fit_colors needs at least one image")
+        ref = 0.0
         if self.config.exposure == "mean":
             # reference level from the upper halves (what the compass scans at pitch 0)
             levels = [mean_linear_level(im[: max(im.shape[0] // 2, 1)]) for im in images]
@@ -223,16 +226,16 @@ class VisualCompass:
                 self._apply_gain(im[: max(im.shape[0] // 2, 1)], lvl, ref)
                 for im, lvl in zip(images, levels, strict=True)
             ]
-            self._exposure_ref = ref
-        self._set_colors(
-            ColorClasses.fit(
-                images,
-                n_colors=self.config.n_colors,
-                rng=rng,
-                bits=self.config.lut_bits,
-                max_samples=max_samples,
-            )
+        colors = ColorClasses.fit(
+            images,
+            n_colors=self.config.n_colors,
+            rng=rng,
+            bits=self.config.lut_bits,
+            max_samples=max_samples,
         )
+        colors.exposure_reference = ref
+        self._exposure_ref = ref
+        self._set_colors(colors)
         if reset_map:
             self.reset_map()
         return self

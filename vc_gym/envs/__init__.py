@@ -16,6 +16,7 @@ from vc_gym.envs.learning import (
     RobotFell,
     ScriptedLearner,
     ScriptedLearning,
+    SpotLearning,
     kidnap_pose,
 )
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
@@ -46,6 +47,7 @@ __all__ = [
     "Scene",
     "ScriptedLearner",
     "ScriptedLearning",
+    "SpotLearning",
     "StopAction",
     "build_scene",
     "kidnap_pose",

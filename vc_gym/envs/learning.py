@@ -9,6 +9,8 @@ recorded for plots, never used.
 
 The task env calls a *learner*: any callable ``learner(room, config) -> LearningResult``
 (default :class:`ScriptedLearning`), so tests and users can bring their own.
+:class:`SpotLearning` is the learner of the paper's orientation experiment (5.1): one
+full turn at a single spot, no walking.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
-from vc_gym.validation import positive_float
+from vc_gym.validation import finite_float, positive_float
 
 __all__ = [
     "HEAD_SCAN_DEG",
@@ -36,6 +38,7 @@ __all__ = [
     "RobotFell",
     "ScriptedLearner",
     "ScriptedLearning",
+    "SpotLearning",
     "kidnap_pose",
 ]
 
@@ -126,7 +129,8 @@ class ScriptedLearner:
     frame). :meth:`learn` turns a full circle there (colour classes, home map, odometry
     turn calibration by loop closure), learns four spots ``spot_distance_m`` around
     home (8 × 45°, ``learn_time_s`` each, head scanning), walks back and normalises the
-    spots' goodness at home.
+    spots' goodness at home. :meth:`learn_turn` is the full turn on its own: the map
+    of the one spot the robot stands on (the paper's orientation experiment, 5.1).
 
     Parameters
     ----------
@@ -153,6 +157,8 @@ class ScriptedLearner:
         self.learn_filter: HeadingGridFilter | None = None
         self.obs: dict | None = None
         self.info: dict | None = None
+        #: true ``(x, y, yaw)`` of every frame of the last :meth:`learn_turn` (plots only)
+        self.turn_path: list[tuple[float, float, float]] = []
 
     def _act(self, forward: float = 0.0, turn: float = 0.0, pan: float = 0.0) -> None:
         action = self.room.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
@@ -204,6 +210,68 @@ class ScriptedLearner:
         d = self.config.spot_distance_m
         return {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
 
+    def _steps_per_direction(self) -> int:
+        """Frames learned per direction: ``learn_time_s`` at the room's control rate."""
+        return max(1, int(round(self.config.learn_time_s / self.dt)))
+
+    def learn_turn(self, steps: int | None = None) -> VisualCompass:
+        """Learn the map of the spot the robot stands on in one full turn (paper 4.3).
+
+        The robot turns a full circle in 8 steps of 45°, ``steps`` frames per
+        direction with head scanning; the colour classes are fitted on the turn's
+        frames and the odometry's turns are calibrated by loop closure (see
+        :meth:`_learn_home`). Afterwards the robot faces where it started and its
+        heading belief is kept on the new map (:attr:`learn_filter`), so it can
+        turn on and, e.g., take normalisation frames.
+
+        Every call starts afresh: the belief is the origin facing 0°, the odometry
+        calibration and the head scan restart. The map's headings are therefore in
+        the frame the robot stood in when the call began — the world frame when it
+        faced the world's 0°.
+
+        Parameters
+        ----------
+        steps : int, optional
+            Frames per direction; default ``round(learn_time_s / control_dt)``
+            (at least 1).
+
+        Returns
+        -------
+        VisualCompass
+            The learned map (also kept as ``home_compass``); the odometry's turn
+            scale is ``rot_scale`` and the true poses of the frames ``turn_path``.
+
+        Raises
+        ------
+        ValueError
+            If ``steps`` is not an int >= 1.
+        RobotFell
+            If the robot falls (only with ``locomotion="dynamic"``).
+        """
+        if steps is None:
+            steps = self._steps_per_direction()
+        elif isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+            raise ValueError(f"steps must be an int >= 1, got {steps!r}")
+        self.belief = np.zeros(3)
+        self.learn_filter = None
+        self.home_compass = None
+        self.rot_scale = 1.0
+        self._scan_i = 0
+        self._learn_home(int(steps))
+        return self.home_compass
+
+    def _normalise(self, atlas: CompassAtlas) -> None:
+        """Normalise ``atlas`` on ``normalise_directions`` frames taken where the robot
+        stands, turning in equal steps (paper 5.2)."""
+        cfg = self.config
+        imgs, cams = [], []
+        for k in range(cfg.normalise_directions):
+            self._turn_to(360.0 * k / cfg.normalise_directions)
+            self._act()
+            imgs.append(self.obs["image"])
+            cams.append(self.camera)
+        atlas.normalize(imgs, cams)
+
     def learn(self) -> LearningResult:
         """Learning phase: home turn, four spots, normalisation at home.
 
@@ -213,12 +281,10 @@ class ScriptedLearner:
             If the robot falls (only with ``locomotion="dynamic"``).
         """
         cfg = self.config
-        self.belief = np.zeros(3)
-        self.learn_filter = None
-        steps = max(1, int(round(cfg.learn_time_s / self.dt)))
+        steps = self._steps_per_direction()
         spots = self.spots()
         path: list[tuple[float, float, float]] = []
-        self._learn_home(steps)
+        self.learn_turn(steps)
         colors = self.home_compass.colors
         compasses = {}
         bar = tqdm(
@@ -239,13 +305,7 @@ class ScriptedLearner:
         bar.close()
         self._walk_to(*HOME)
         atlas = CompassAtlas(compasses, home="home", home_position=HOME)
-        imgs, cams = [], []
-        for k in range(cfg.normalise_directions):
-            self._turn_to(360.0 * k / cfg.normalise_directions)
-            self._act()
-            imgs.append(self.obs["image"])
-            cams.append(self.camera)
-        atlas.normalize(imgs, cams)
+        self._normalise(atlas)
         return LearningResult(atlas, spots, path, self.rot_scale)
 
     def _learn_home(self, steps: int) -> None:
@@ -260,6 +320,7 @@ class ScriptedLearner:
         """
         cfg = self.config
         self.turn_accum = 0.0
+        self.turn_path = []
         start = float(self.belief[2])
         frames = []  # (image, believed body turn since the start, head pan, direction)
         for k in range(8):
@@ -267,6 +328,7 @@ class ScriptedLearner:
             for _ in range(steps):
                 self._act(pan=self._next_pan())
                 frames.append((self.obs["image"], self.turn_accum, float(self.obs["head"][0]), k))
+                self.turn_path.append(tuple(float(v) for v in self.info["pose"]))
         self._turn_to(start)
         for _ in range(3):
             self._act()
@@ -308,6 +370,73 @@ class ScriptedLearning:
 
     def __call__(self, room, config: LearningConfig) -> LearningResult:
         return ScriptedLearner(room, config, progress=self.progress).learn()
+
+
+class SpotLearning:
+    """A learner for the paper's orientation experiment (5.1): one spot, one full turn.
+
+    The robot is placed at ``spot`` facing the world's 0°, learns the panorama there
+    in a full turn (:meth:`ScriptedLearner.learn_turn`: 8 × 45°, ``learn_time_s``
+    each with head scanning, colour classes, odometry loop closure) and normalises
+    the spot's goodness on ``normalise_directions`` frames taken at the spot, so that
+    the normalised goodness ``L̂`` (eq. 28) is 1 there (as the paper's 5.2 does at
+    home; figure 5 right plots it over the field).
+
+    Parameters
+    ----------
+    spot : tuple of float
+        The training spot ``(x, y)`` in world metres (paper 5.1: the centre of the rear
+        field half).
+
+    Examples
+    --------
+    >>> room.reset(seed=1)                                     # doctest: +SKIP
+    >>> result = SpotLearning((-1.5, 0.0))(room, LearningConfig())  # doctest: +SKIP
+    >>> result.atlas.names                                     # doctest: +SKIP
+    ('spot',)
+    """
+
+    #: Name of the one spot of the atlas (and its home).
+    name = "spot"
+
+    def __init__(self, spot: tuple[float, float]):
+        try:
+            x, y = spot
+        except (TypeError, ValueError):
+            raise ValueError(f"spot must be (x, y) in metres, got {spot!r}") from None
+        self.spot = (finite_float("spot x", x), finite_float("spot y", y))
+
+    def __repr__(self) -> str:
+        return f"SpotLearning(spot={self.spot})"
+
+    def __call__(self, room, config: LearningConfig) -> LearningResult:
+        """Learn the spot on ``room`` (``AiboRoomEnv``, unwrapped) with ``config``.
+
+        The room is reset without a seed (its random generator continues from the
+        caller's last reset) with the robot at the spot facing 0°.
+
+        Returns
+        -------
+        LearningResult
+            ``atlas``: one spot named ``"spot"`` at ``spot``, its home, normalised;
+            ``spots``: ``{"spot": spot}``; ``true_path``: the true poses of the
+            turn's frames; ``odometry_turn_scale``: the loop-closure correction.
+
+        Raises
+        ------
+        RobotFell
+            If the robot falls (only with ``locomotion="dynamic"``).
+        """
+        if not isinstance(config, LearningConfig):
+            raise ValueError(f"config must be a LearningConfig, got {type(config).__name__}")
+        room.reset(options={"pose": (*self.spot, 0.0)})
+        learner = ScriptedLearner(room, config)
+        compass = learner.learn_turn()
+        atlas = CompassAtlas({self.name: (self.spot, compass)}, home=self.name)
+        learner._normalise(atlas)
+        return LearningResult(
+            atlas, {self.name: self.spot}, list(learner.turn_path), learner.rot_scale
+        )
 
 
 def kidnap_pose(

@@ -19,8 +19,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
+
 from vc_gym.compass import CompassAtlas, CompassConfig
-from vc_gym.envs.learning import LearningConfig, LearningResult
+from vc_gym.envs.learning import LearningConfig, LearningResult, SpotLearning
 from vc_gym.errors import MapFileError
 from vc_gym.experiments.runner import ExperimentRun, Job
 
@@ -111,8 +113,6 @@ class SavedAtlas:
 
 def _learner(spec: Mapping[str, Any]):
     if spec["learner"] == "spot":
-        from vc_gym.envs.learning import SpotLearning
-
         return SpotLearning(tuple(spec["spot"]))
     return None  # the task's default: the paper's scripted learning
 
@@ -122,8 +122,6 @@ def learn_atlas_job(spec: dict[str, Any], path: str) -> dict[str, Any]:
 
     Returns the learning's figures (also kept in the atlas file's metadata).
     """
-    import gymnasium as gym
-
     env = gym.make(
         "vc_gym/LearnThenHome-v0",
         scene=spec["scene"],

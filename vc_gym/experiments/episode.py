@@ -5,7 +5,9 @@ compass and a tracker, or the env a learned agent was trained on) and its policy
 :func:`run_episode` runs one kidnapping with it and returns an :class:`EpisodeRecord`
 (true and estimated trajectory, heading error, where and how it ended). The demo,
 ``vc-gym evaluate`` and the experiments all go through these two functions, so the
-same seed gives the same episode everywhere.
+same seed gives the same episode everywhere. An optional ``on_step`` hook sees every
+step as an :class:`EpisodeStep` (the episode video, :mod:`vc_gym.experiments.video`,
+is one) without changing what is recorded.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from tqdm import tqdm
 from vc_gym.angles import wrap180
 from vc_gym.localization import TrackerSpec
 
-__all__ = ["EpisodeRecord", "HomingRun", "make_homing_run", "run_episode"]
+__all__ = ["EpisodeRecord", "EpisodeStep", "HomingRun", "make_homing_run", "run_episode"]
 
 
 @dataclass
@@ -78,6 +80,44 @@ class EpisodeRecord:
         }
 
 
+@dataclass(frozen=True)
+class EpisodeStep:
+    """One decision of an episode, as :func:`run_episode` hands it to ``on_step``.
+
+    Attributes
+    ----------
+    index : int
+        Decision number, from 0.
+    sim_time_s : float
+        Homing time after this step (``info["sim_time"]``), seconds.
+    observation : Any
+        What the policy will see next (a dict for the scripted agent's env, holding
+        ``"image"`` when the run was made with ``keep_image=True``; a feature vector for a
+        learned agent's env).
+    info : dict
+        The step's ``info`` (``pose``, ``head``, ``home_error_m``, ...; at the end also
+        ``stop_position``, ``stopped``, ``success``).
+    true_pose : tuple of float
+        True ``(x, y, heading_deg)``; for evaluation and display only.
+    estimate : dict or None
+        The tracker's belief (``info["estimate"]``: ``heading_deg``,
+        ``heading_spread_deg``, ``position``, ``position_std_m``), ``None`` without one.
+    """
+
+    index: int
+    sim_time_s: float
+    observation: Any
+    info: dict[str, Any]
+    true_pose: tuple[float, float, float]
+    estimate: dict[str, Any] | None
+
+    @property
+    def image(self) -> np.ndarray | None:
+        """The head-camera frame if the observation carries one, else ``None``."""
+        obs = self.observation
+        return obs.get("image") if isinstance(obs, dict) else None
+
+
 @dataclass
 class HomingRun:
     """A task env and the policy that acts in it.
@@ -109,6 +149,7 @@ def make_homing_run(
     relearn: str = "scene",
     max_homing_s: float = 60.0,
     learner: Callable | None = None,
+    keep_image: bool = False,
 ) -> HomingRun:
     """The homing task with the paper's 5 s stop rule, and an agent to run it.
 
@@ -125,6 +166,12 @@ def make_homing_run(
         Task arguments (see ``LearnThenHomeEnv``).
     learner : callable, optional
         The task's learner (default: the paper's scripted learning phase).
+    keep_image : bool
+        Keep the head-camera frame in the scripted agent's observations (for an
+        episode video; the policy ignores it, the episode is the same). A learned
+        agent's env turns its observation into a feature vector and has no frame to
+        keep: this argument does not change it (the video renders the frame from the
+        env instead, see :class:`~vc_gym.experiments.video.EpisodeVideo`).
     """
     from vc_gym.agents.scripted import ScriptedHomingPolicy
     from vc_gym.envs.compass_observation import CompassObservation
@@ -141,7 +188,7 @@ def make_homing_run(
         task["learner"] = learner
     if agent == "scripted":
         env = gym.make("vc_gym/LearnThenHome-v0", **task)
-        env = CompassObservation(env, keep_image=False, tracker=tracker)
+        env = CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
         policy = ScriptedHomingPolicy.for_env(env)
         return HomingRun(env, policy.predict, policy.reset)
     from vc_gym.agents.learned import LearnedHomingAgent
@@ -165,6 +212,7 @@ def run_episode(
     seed: int | None = None,
     options: dict[str, Any] | None = None,
     progress: bool = False,
+    on_step: Callable[[EpisodeStep], None] | None = None,
 ) -> EpisodeRecord:
     """Reset the task (a kidnapping) and act until the episode ends; record everything.
 
@@ -178,6 +226,10 @@ def run_episode(
         Reset options (``{"pose": (x, y, yaw)}`` sets the kidnapping pose).
     progress : bool
         Show a progress bar over the homing time limit.
+    on_step : callable, optional
+        ``on_step(EpisodeStep)`` after every step (a learned agent's stop decision is
+        one step), after it is recorded; it must not step or reset the env nor modify
+        the observation or info it is given. Watching does not change the episode.
 
     Returns
     -------
@@ -207,6 +259,17 @@ def run_episode(
                 h = float(est["heading_deg"])
                 record.estimated.append((*est["position"], h))
                 record.heading_error.append(float(wrap180(h - true[2])))
+            if on_step is not None:
+                on_step(
+                    EpisodeStep(
+                        index=record.decisions - 1,
+                        sim_time_s=float(info.get("sim_time", 0.0)),
+                        observation=obs,
+                        info=info,
+                        true_pose=true,
+                        estimate=est,
+                    )
+                )
             bar.update(min(limit, int(round(float(info.get("sim_time", 0.0)) / dt))) - bar.n)
             if terminated or truncated:
                 break

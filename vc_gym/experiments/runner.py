@@ -237,34 +237,54 @@ class LocalBackend:
 
     def _pool_run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
         queue = list(range(len(jobs)))[::-1]
+        # Jobs that were running when a worker died: the pool cannot say whose worker
+        # it was, so they run again one at a time, and only a job that kills its
+        # worker while running alone is charged with the failure.
+        suspects: list[int] = []
+        isolating: int | None = None
         running: dict[cf.Future, int] = {}
-        while queue or running:
+        while queue or running or suspects:
             pool = self._pool()
-            # at most one job per worker in flight: a dead worker then fails only the
-            # jobs that were really running
-            while queue and len(running) < self.workers:
-                i = queue.pop()
-                running[pool.submit(_execute, jobs[i].fn, jobs[i].kwargs)] = i
+            if not running and suspects:
+                isolating = suspects.pop()
+                running[pool.submit(_execute, *_call(jobs[isolating]))] = isolating
+            elif isolating is None:
+                while queue and len(running) < self.workers:
+                    i = queue.pop()
+                    running[pool.submit(_execute, *_call(jobs[i]))] = i
             done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
-            broken = False
+            alone = len(running) == 1
+            broken: list[int] = []
             for fut in done:
                 i = running.pop(fut)
                 try:
-                    yield (i, *fut.result())
+                    result = fut.result()
                 except BrokenProcessPool:
-                    broken = True
-                    msg = (
-                        "the worker process died while running this job "
-                        "(killed, out of memory, or a crash in native code)"
-                    )
-                    yield i, False, {"error": msg, "traceback": msg}, math.nan
-            if broken:  # every job still running failed with it: start a new pool
-                for fut, i in list(running.items()):
-                    running.pop(fut)
-                    msg = "the pool broke (another worker died) while this job ran"
-                    yield i, False, {"error": msg, "traceback": msg}, math.nan
+                    broken.append(i)
+                    continue
+                if i == isolating:
+                    isolating = None
+                yield (i, *result)
+            if broken:
+                broken += list(running.values())  # they died with the pool
+                running.clear()
                 self._executor.shutdown(wait=False, cancel_futures=True)
                 self._executor = None
+                isolating = None
+                if alone:
+                    yield broken[0], False, {"error": _DIED, "traceback": _DIED}, math.nan
+                else:
+                    suspects.extend(broken)
+
+
+_DIED = (
+    "the worker process died while running this job (killed, out of memory, or a crash "
+    "in native code)"
+)
+
+
+def _call(job: Job) -> tuple[str, Mapping[str, Any]]:
+    return job.fn, job.kwargs
 
 
 def _noop(_: int) -> None:
@@ -403,7 +423,15 @@ def package_versions() -> dict[str, str]:
     from importlib import metadata
 
     versions = {"python": platform.python_version()}
-    for dist in ("vc_gym", "numpy", "opencv-python", "pybullet", "gymnasium", "ray"):
+    for dist in (
+        "vc_gym",
+        "numpy",
+        "opencv-python-headless",
+        "pybullet",
+        "gymnasium",
+        "filterpy",
+        "ray",
+    ):
         try:
             versions[dist] = metadata.version(dist)
         except metadata.PackageNotFoundError:
@@ -452,6 +480,7 @@ class ExperimentRun:
         self.retries = int(retries)
         self.failures: list[dict[str, Any]] = []
         self.stages: dict[str, dict[str, Any]] = {}
+        self._stage_raw: dict[str, dict[str, Any]] = {}
         self.timings: dict[str, dict[str, Any]] = {}
         self._t0 = time.perf_counter()
         self._check_settings()
@@ -546,17 +575,15 @@ class ExperimentRun:
                 round_jobs = again
         wall = time.perf_counter() - t0
         ran = [o for o in outcomes.values() if not o.resumed]
-        secs = sorted(o.seconds for o in ran if o.seconds is not None and math.isfinite(o.seconds))
-        self.stages[stage] = {
-            "jobs": len(jobs),
-            "ran": len(ran),
-            "resumed": len(jobs) - len(ran),
-            "failed": sum(not o.ok for o in outcomes.values()),
-            "retried": retried,
-            "wall_s": round(wall, 3),
-            "jobs_per_s": round(len(ran) / wall, 4) if ran and wall > 0 else None,
-            "job_s_median": round(secs[len(secs) // 2], 4) if secs else None,
-        }
+        self._record_stage(
+            stage,
+            jobs=len(jobs),
+            ran=len(ran),
+            failed=sum(not o.ok for o in outcomes.values()),
+            retried=retried,
+            wall=wall,
+            seconds=[o.seconds for o in ran if o.seconds is not None and math.isfinite(o.seconds)],
+        )
         results: list[dict[str, Any] | None] = []
         stage_timing: dict[str, Any] = {}
         for job in jobs:
@@ -573,8 +600,29 @@ class ExperimentRun:
                 stage_timing[job.key] = timing
             results.append(out)
         if stage_timing:
-            self.timings[stage] = stage_timing
+            self.timings.setdefault(stage, {}).update(stage_timing)
         return results
+
+    def _record_stage(self, stage: str, **new: Any) -> None:
+        """Add a call's counts to its stage (a stage may run in several calls)."""
+        old = self._stage_raw.get(stage)
+        if old is not None:
+            for k in ("jobs", "ran", "failed", "retried", "wall"):
+                new[k] += old[k]
+            new["seconds"] = old["seconds"] + new["seconds"]
+        self._stage_raw[stage] = new
+        secs = sorted(new["seconds"])
+        ran, wall = new["ran"], new["wall"]
+        self.stages[stage] = {
+            "jobs": new["jobs"],
+            "ran": ran,
+            "resumed": new["jobs"] - ran,
+            "failed": new["failed"],
+            "retried": new["retried"],
+            "wall_s": round(wall, 3),
+            "jobs_per_s": round(ran / wall, 4) if ran and wall > 0 else None,
+            "job_s_median": round(secs[len(secs) // 2], 4) if secs else None,
+        }
 
     def _save(self, stage: str, job: Job, outcome: JobOutcome, out: Any) -> None:
         rec = {

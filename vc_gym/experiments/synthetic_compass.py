@@ -2,7 +2,7 @@
 
 Learns a room panorama the way the paper's robot does (8 body directions of 45°, each
 with head scanning, paper 4.3), then estimates the heading of random test frames at
-normal and at half illumination (paper 5.3), and writes ``synthetic_compass.json``
+normal and at half illumination (paper 5.3), and writes ``results.json``
 and ``synthetic_compass.png``.
 """
 
@@ -47,7 +47,7 @@ def _evaluate(
 def run_synthetic_compass(
     out_dir: str | os.PathLike = "vc_gym_synthetic", seed: int = 0, n_test: int = 120
 ) -> dict:
-    """Run the experiment; write ``synthetic_compass.json`` and ``.png`` to ``out_dir``.
+    """Run the experiment; write ``results.json`` and ``.png`` to ``out_dir``.
 
     Returns the summary dict.
     """
@@ -95,7 +95,7 @@ def run_synthetic_compass(
     }
     _plot(out / "synthetic_compass.png", panos, curves, example)
     summary["duration_s"] = round(time.perf_counter() - t_start, 2)
-    write_json(out / "synthetic_compass.json", summary)
+    write_json(out / "results.json", summary)
     return summary
 
 

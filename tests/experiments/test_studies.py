@@ -1,0 +1,165 @@
+"""Every experiment end to end at --quick; backends, worker counts, resume and failures."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import shutil
+
+import cv2
+import pytest
+
+from vc_gym.cli import main
+from vc_gym.experiments.studies import EXPERIMENTS
+
+QUICK = ["--quick", "--seed", "0"]
+
+
+@pytest.fixture(scope="module")
+def paper_quick(tmp_path_factory):
+    """``vc-gym experiment paper --quick``: every experiment once, and the report."""
+    out = tmp_path_factory.mktemp("paper")
+    assert main(["experiment", "paper", "--out", str(out), *QUICK, "--json"]) == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def homing_quick(tmp_path_factory):
+    """The quick homing experiment with 2 local workers and one episode on video."""
+    out = tmp_path_factory.mktemp("homing") / "two"
+    argv = ["experiment", "homing", "--out", str(out), *QUICK, "--workers", "2"]
+    assert main([*argv, "--video", "1", "--json"]) == 0
+    return out
+
+
+@pytest.mark.parametrize("name", [n for n in EXPERIMENTS if n != "paper"])
+def test_every_experiment_wrote_its_files(paper_quick, name):
+    folder = paper_quick / name
+    results = json.loads((folder / "results.json").read_text())
+    run = json.loads((folder / "run.json").read_text())
+    assert results["experiment"] == name and results["failed_jobs"] == []
+    assert results["settings"]["size"] == "quick"
+    assert run["backend"] == "local" and run["stages"] and "versions" in run
+    for stage in run["stages"].values():
+        assert stage["failed"] == 0
+    text = (folder / "results.json").read_text()
+    for word in ("seconds", "duration", "timing", "ms_per", str(paper_quick)):
+        assert word not in text, word  # figures only: no timings, no paths
+    assert list(folder.glob("*.png")), "no plot"
+
+
+def test_the_report_sets_our_figures_beside_the_papers(paper_quick):
+    report = (paper_quick / "report.md").read_text()
+    for claim in ("within 2 m", "(−22, +12) cm", "three colour classes", "1 %", "half"):
+        assert claim in report
+    results = json.loads((paper_quick / "results.json").read_text())
+    assert len(results["claims"]) >= 6
+    assert all(isinstance(c["holds"], bool) for c in results["claims"])
+    for line in report.splitlines():  # every linked plot exists
+        if line.startswith("!["):
+            assert (paper_quick / line.split("](")[1].rstrip(")")).is_file()
+    # the atlases were learned once and shared: trackers reused homing's
+    trackers_run = json.loads((paper_quick / "trackers" / "run.json").read_text())
+    homing_key = next((paper_quick / "homing" / "atlases").glob("*.npz")).name
+    assert (paper_quick / "trackers" / "atlases" / homing_key).is_file()
+    learned = trackers_run["stages"].get("learn", {"ran": 0})["ran"]
+    assert learned == 0  # robolab's spot atlas and home atlas both came from the pool
+
+
+def test_orientation_reports_every_tracker_by_distance(paper_quick):
+    r = json.loads((paper_quick / "orientation" / "results.json").read_text())
+    robolab = r["scenes"]["robolab"]
+    assert robolab["training_spot"] == [-1.5, 0.0]
+    assert set(robolab["trackers"]) == {"grid", "kalman", "particle", "compass"}
+    for t in robolab["trackers"].values():
+        assert t["by_distance"] and sum(b["n"] for b in t["by_distance"]) == robolab["views"]
+
+
+def test_homing_results_and_video(homing_quick):
+    r = json.loads((homing_quick / "results.json").read_text())
+    assert [e["seed"] for e in r["per_episode"]] == [1, 2]
+    (seed0,) = r["per_seed"]
+    assert seed0["episodes"] == 2 and 0.0 <= seed0["success_rate"] <= 1.0
+    assert r["paper"]["mean_stop_offset_cm"] == [-22.0, 12.0]
+    field = r["likelihood_field"]
+    assert len(field["positions"]) == len(field["goodness"]["east"]) > 4
+    (video,) = (homing_quick / "videos").glob("*.mp4")
+    cap = cv2.VideoCapture(str(video))
+    assert cap.isOpened() and cap.get(cv2.CAP_PROP_FRAME_COUNT) > 5
+    cap.release()
+
+
+def test_one_worker_and_a_resumed_run_give_the_same_bytes(homing_quick, tmp_path):
+    one = tmp_path / "one"
+    argv = ["experiment", "homing", "--out", str(one), *QUICK, "--workers", "1"]
+    atlases = homing_quick / "atlases"
+    assert main([*argv, "--atlas", str(atlases), "--json"]) == 0
+    run = json.loads((one / "run.json").read_text())
+    assert "learn" not in run["stages"]  # the saved atlas was reused, not relearned
+    assert (one / "results.json").read_bytes() == (homing_quick / "results.json").read_bytes()
+    # the same command again: every job is resumed, nothing runs, same bytes
+    assert main([*argv, "--json"]) == 0
+    run = json.loads((one / "run.json").read_text())
+    assert all(s["ran"] == 0 for s in run["stages"].values())
+    assert (one / "results.json").read_bytes() == (homing_quick / "results.json").read_bytes()
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="needs vc_gym[cluster]")
+def test_ray_gives_the_same_bytes_as_the_local_pool(homing_quick, tmp_path):
+    out = tmp_path / "ray"
+    shutil.copytree(homing_quick / "atlases", tmp_path / "atlases")
+    argv = ["experiment", "homing", "--out", str(out), *QUICK, "--backend", "ray"]
+    assert main([*argv, "--workers", "2", "--atlas", str(tmp_path / "atlases"), "--json"]) == 0
+    run = json.loads((out / "run.json").read_text())
+    assert run["backend"] == "ray" and run["cluster"] == "local"
+    assert (out / "results.json").read_bytes() == (homing_quick / "results.json").read_bytes()
+
+
+class DyingTracker:
+    """A tracker whose worker process dies at its first frame (as if OOM-killed)."""
+
+    def reset(self, atlas, camera, dt_s):
+        pass
+
+    def update(self, image, head_pan_deg, odometry):
+        import os
+
+        os._exit(9)
+
+
+def test_a_dead_worker_fails_its_jobs_clearly_not_the_run(homing_quick, tmp_path, capsys):
+    argv = ["evaluate", "--out", str(tmp_path), "--episodes", "2", "--workers", "2"]
+    argv += ["--learn-time", "0.3", "--max-homing", "15"]
+    shutil.copytree(homing_quick / "atlases", tmp_path / "atlases")
+    code = main([*argv, "--tracker", f"{__name__}:DyingTracker"])
+    assert code == 1
+    assert "worker process died" in capsys.readouterr().err
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert [f["key"] for f in results["failed_jobs"]] == ["seed0-episode000", "seed0-episode001"]
+    assert all(f["attempts"] == 2 for f in results["failed_jobs"])
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["experiment", "params", "--agent", "scripted"], "does not take --agent"),
+        (["experiment", "homing", "--tracker", "grid", "--tracker", "kalman"], "one --tracker"),
+        (["experiment", "orientation", "--tracker", "kalmann"], "unknown tracker"),
+        (["experiment", "trackers", "--scenes", "nowhere"], "nowhere"),
+        (["experiment", "homing", "--backend", "local", "--address", "auto"], "address"),
+        (["experiment", "homing", "--atlas", "/no/such/folder"], "not a folder"),
+        (["experiment", "homing", "--seeds", "1,1"], "distinct"),
+    ],
+)
+def test_bad_arguments_fail_before_any_work(tmp_path, capsys, argv, message):
+    out = tmp_path / "out"
+    assert main([*argv, "--out", str(out), "--quick"]) == 2
+    assert message in capsys.readouterr().err
+    assert not (out / "jobs").exists()
+
+
+def test_an_output_that_is_a_file_is_refused_at_once(tmp_path, capsys):
+    (tmp_path / "taken").write_text("mine")
+    assert main(["experiment", "homing", "--out", str(tmp_path / "taken"), "--quick"]) == 2
+    assert "not a folder" in capsys.readouterr().err
+    assert (tmp_path / "taken").read_text() == "mine"

@@ -1,0 +1,88 @@
+"""What every experiment shares: sizes, seeds, the run folder and progress."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from vc_gym.experiments.runner import ExperimentRun, LocalBackend, RayBackend, make_backend
+
+__all__ = ["SIZES", "ExperimentOptions", "open_run", "pick_size"]
+
+#: ``quick``: the size the tests use (seconds to a minute); ``paper``: the size of the
+#: ``paper`` report (all experiments in < 20 min on 2 cores); ``full``: the default.
+SIZES = ("quick", "paper", "full")
+
+
+@dataclass(frozen=True)
+class ExperimentOptions:
+    """Options every experiment takes (the CLI's common flags).
+
+    Attributes
+    ----------
+    seed : int
+        Base seed: learning seeds, kidnappings and view poses all derive from it.
+    size : str
+        ``"quick"``, ``"paper"`` or ``"full"`` (:data:`SIZES`).
+    backend : LocalBackend or RayBackend, optional
+        Who runs the jobs (default: a local pool of 2 workers).
+    atlas_dir : path-like, optional
+        A folder of saved atlases to reuse (``--atlas DIR``).
+    video : int
+        Write the first N homing episodes as MP4.
+    progress : bool
+        Show progress bars.
+    """
+
+    seed: int = 0
+    size: str = "full"
+    backend: LocalBackend | RayBackend | None = None
+    atlas_dir: str | os.PathLike | None = None
+    video: int = 0
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise ValueError(f"seed must be an int >= 0, got {self.seed!r}")
+        if self.size not in SIZES:
+            raise ValueError(f"size must be one of {SIZES}, got {self.size!r}")
+        if isinstance(self.video, bool) or not isinstance(self.video, int) or self.video < 0:
+            raise ValueError(f"video must be an int >= 0, got {self.video!r}")
+        if self.atlas_dir is not None and not os.path.isdir(self.atlas_dir):
+            raise ValueError(f"--atlas {self.atlas_dir}: not a folder")
+
+
+def pick_size(table: Mapping[str, Mapping[str, Any]], size: str) -> dict[str, Any]:
+    """The entry of ``table`` for ``size`` (every experiment has one per size)."""
+    return dict(table[size])
+
+
+def open_run(
+    out_dir: str | os.PathLike, name: str, opts: ExperimentOptions, settings: Mapping[str, Any]
+) -> ExperimentRun:
+    """The run folder of experiment ``name`` with its settings recorded."""
+    backend = opts.backend if opts.backend is not None else make_backend("local")
+    return ExperimentRun(
+        out_dir,
+        name,
+        backend,
+        {"seed": opts.seed, "size": opts.size, **settings},
+        progress=opts.progress,
+        owns_backend=opts.backend is None,
+    )
+
+
+def scene_field_bounds(scene: str) -> tuple[float, float, float, float]:
+    """``(x0, x1, y0, y1)`` of a registered scene's field (builds the scene once)."""
+    from vc_gym.envs.aibo_room import AiboRoomEnv
+    from vc_gym.envs.scenes import check_scene_name
+
+    check_scene_name(scene)
+    room = AiboRoomEnv(scene=scene)
+    try:
+        room.reset(seed=0)
+        return tuple(float(v) for v in room.scene.field_bounds)  # type: ignore[return-value]
+    finally:
+        room.close()

@@ -1,0 +1,439 @@
+"""The paper's homing experiment (5.2, fig. 5): stop positions over many kidnappings.
+
+For every learning seed the robot learns the four spots 1 m around home once (the
+atlas is saved and shared by every job), then each kidnapping is one job: a random pose
+on the field from its own seed, homing with the scripted agent (or a learned one) and
+any tracker until it has stood still for 5 s. The results hold every stop position, the
+mean and standard deviation per axis (the paper: mean (−22, +12) cm, standard deviation
+(17, 15) cm over 33 kidnappings), mean stop distance, success within 30 cm and stops
+more than 50 cm from home, per learning seed and over all of them; and the likelihood
+field of one spot over a 50 cm grid (fig. 5 right: the goodness of the map learned at
+T = (100, 0) cm where the robot stands).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
+from vc_gym.experiments.episode import make_homing_run, run_episode
+from vc_gym.experiments.output import new_figure, save_figure
+from vc_gym.experiments.runner import Job, worker_cache
+from vc_gym.experiments.studies.common import (
+    ExperimentOptions,
+    open_run,
+    pick_size,
+    scene_field_bounds,
+)
+from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
+from vc_gym.localization import make_tracker
+from vc_gym.validation import positive_float
+
+__all__ = ["PAPER_MEAN_CM", "PAPER_STD_CM", "run_homing", "episode_job", "summarise_stops"]
+
+PAPER_MEAN_CM = (-22.0, 12.0)
+PAPER_STD_CM = (17.0, 15.0)
+#: A stop this far from home is a "far stop": the robot trusted a position it had no
+#: evidence for (or never found home).
+FAR_STOP_M = 0.5
+
+SIZES = {
+    "quick": {
+        "episodes": 2,
+        "learn_time_s": 0.3,
+        "max_homing_s": 15.0,
+        "field_spacing_m": 2.0,
+        "field_headings": 2,
+        "field_frames": 2,
+    },
+    "paper": {
+        "episodes": 33,
+        "learn_time_s": 5.0,
+        "max_homing_s": 60.0,
+        "field_spacing_m": 0.5,
+        "field_headings": 4,
+        "field_frames": 4,
+    },
+    "full": {
+        "episodes": 33,
+        "learn_time_s": 5.0,
+        "max_homing_s": 60.0,
+        "field_spacing_m": 0.5,
+        "field_headings": 8,
+        "field_frames": 8,
+    },
+}
+
+
+def check_tracker_spec(tracker: Any) -> Any:
+    """A tracker that can travel to a worker: a name, ``"module:factory"`` or a dict."""
+    if not isinstance(tracker, str | Mapping):
+        raise ValueError(
+            "an experiment's tracker must be a name, 'package.module:factory' or a "
+            f'{{"type": ...}} dict (the jobs run in other processes), got {tracker!r}'
+        )
+    make_tracker(tracker)  # an unknown tracker fails here, not in a worker
+    return json.loads(json.dumps(tracker))
+
+
+def _run_for(kwargs: Mapping[str, Any]):
+    atlas = kwargs["atlas"]
+    run = make_homing_run(
+        kwargs["agent"],
+        tracker=kwargs["tracker"],
+        scene=kwargs["scene"],
+        learn_time_s=kwargs["learn_time_s"],
+        success_radius_m=kwargs["success_radius_m"],
+        relearn="scene" if atlas else "episode",
+        max_homing_s=kwargs["max_homing_s"],
+        learner=SavedAtlas(atlas) if atlas else None,
+        keep_image=kwargs.get("video") is not None,
+    )
+    if atlas:
+        run.env.reset(seed=kwargs["learning_seed"])  # loads the saved atlas
+    return run
+
+
+def episode_job(
+    agent: str,
+    tracker: Any,
+    scene: str,
+    learn_time_s: float,
+    success_radius_m: float,
+    max_homing_s: float,
+    atlas: str | None,
+    learning_seed: int,
+    episode_seed: int,
+    video: str | None = None,
+) -> dict[str, Any]:
+    """Job: one kidnapping (seed ``episode_seed``) with the saved ``atlas``.
+
+    ``atlas=None`` learns anew in the episode (``relearn="episode"``). With ``video``
+    the episode is also written there as MP4. Returns the episode's figures.
+    """
+    kwargs = dict(locals())
+    cache_key = json.dumps(
+        {k: v for k, v in kwargs.items() if k not in ("episode_seed",)}, sort_keys=True
+    )
+    run = worker_cache(("homing-run", cache_key), lambda: _run_for(kwargs))
+    if video is not None:
+        from vc_gym.experiments.video import write_episode_video
+
+        record = write_episode_video(run, episode_seed, video)
+    else:
+        record = run_episode(run, seed=episode_seed)
+    out = record.summary()
+    out["learning_seed"] = learning_seed
+    ms = 1e3 * record.tracker_time_s / record.tracker_updates if record.tracker_updates else None
+    out["timing"] = {"tracker_ms_per_update": ms}
+    return out
+
+
+def field_job(
+    scene: str, atlas: str, x: float, y: float, headings: list[float], frames: int, seed: int
+) -> dict[str, Any]:
+    """Job: the mean normalised goodness of every spot at ``(x, y)`` (fig. 5 right)."""
+    from vc_gym.envs.aibo_room import AiboRoomEnv
+
+    room = worker_cache(("room", scene), lambda: AiboRoomEnv(scene=scene))
+    loaded = worker_cache(("atlas", atlas), lambda: CompassAtlas.load(atlas))
+    camera = Camera(hfov_deg=room.camera.hfov_deg)
+    per_heading = []
+    for k, h in enumerate(headings):
+        seen = look(room, (x, y, h), frames, seed=seed + k)
+        per_heading.append(spot_goodness(seen, loaded, camera))
+    return {
+        "position": [x, y],
+        "goodness": {n: float(np.mean([g[n] for g in per_heading])) for n in loaded.names},
+    }
+
+
+def summarise_stops(episodes: Sequence[Mapping[str, Any]], success_radius_m: float) -> dict:
+    """Mean / std stop offset per axis (cm), distances, success and far stops."""
+    off = np.array([e["stop_offset_m"] for e in episodes], np.float64) * 100.0
+    dist = np.hypot(off[:, 0], off[:, 1])
+    n = len(episodes)
+    return {
+        "episodes": n,
+        "mean_stop_offset_cm": off.mean(axis=0).round(1).tolist(),
+        "std_stop_offset_cm": off.std(axis=0, ddof=1).round(1).tolist() if n > 1 else None,
+        "mean_stop_distance_cm": round(float(dist.mean()), 1),
+        "median_stop_distance_cm": round(float(np.median(dist)), 1),
+        "success_rate": round(float(np.mean([e["success"] for e in episodes])), 4),
+        "success_radius_m": success_radius_m,
+        "far_stops": int(
+            sum(e["stopped"] and d > FAR_STOP_M * 100 for e, d in zip(episodes, dist, strict=True))
+        ),
+        "stopped": int(sum(e["stopped"] for e in episodes)),
+        "timed_out": int(sum(e["timed_out"] for e in episodes)),
+        "fell": int(sum(e["fell"] for e in episodes)),
+        "mean_homing_time_s": round(float(np.mean([e["sim_time_s"] for e in episodes])), 1),
+        "mean_heading_error_deg": round(
+            float(np.mean([e["mean_heading_error_deg"] or 0.0 for e in episodes])), 2
+        ),
+    }
+
+
+def _mean_std(values: Sequence[float]) -> list[float]:
+    v = np.asarray(values, np.float64)
+    return [round(float(v.mean()), 4), round(float(v.std(ddof=1)) if v.size > 1 else 0.0, 4)]
+
+
+def run_homing(
+    out_dir: str | os.PathLike,
+    opts: ExperimentOptions | None = None,
+    agent: str = "scripted",
+    tracker: Any = "grid",
+    seeds: Sequence[int] | None = None,
+    episodes: int | None = None,
+    scene: str = "robolab",
+    learn_time_s: float | None = None,
+    max_homing_s: float | None = None,
+    success_radius_m: float = 0.3,
+    relearn: str = "scene",
+    field: bool = True,
+) -> dict[str, Any]:
+    """Run the homing experiment and write ``results.json``, ``run.json`` and plots.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        The run folder (resumable).
+    opts : ExperimentOptions
+        Seed, size, backend, ``--atlas``, ``--video``, progress.
+    agent : str
+        ``"scripted"``, ``"pretrained"`` or a learned agent's ``model.zip``.
+    tracker : str or dict
+        The tracker of every episode (a name, ``"module:factory"`` or a dict).
+    seeds : sequence of int, optional
+        Learning seeds (default: ``[opts.seed]``); kidnapping ``i`` of seed ``s`` uses
+        seed ``s + 1 + i`` (so ``vc-gym demo --seed s`` is its first episode).
+    episodes : int, optional
+        Kidnappings per learning seed (default by size: 33, the paper's).
+    scene : str
+        Registered scene (a learned agent brings its own).
+    learn_time_s, max_homing_s : float, optional
+        Learning time per direction and homing time limit (defaults by size).
+    success_radius_m : float
+        A stop within this distance of home is a success.
+    relearn : str
+        ``"scene"``: learn once per seed (the paper's protocol); ``"episode"``: learn
+        anew in every episode (slow).
+    field : bool
+        Also measure the likelihood field of fig. 5 (right).
+
+    Returns
+    -------
+    dict
+        The results written to ``results.json``.
+    """
+    opts = opts or ExperimentOptions()
+    size = pick_size(SIZES, opts.size)
+    episodes = size["episodes"] if episodes is None else episodes
+    learn_time_s = size["learn_time_s"] if learn_time_s is None else learn_time_s
+    max_homing_s = size["max_homing_s"] if max_homing_s is None else max_homing_s
+    seeds = [opts.seed] if seeds is None else [int(s) for s in seeds]
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ValueError(f"episodes must be an int >= 1, got {episodes!r}")
+    if not seeds or any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
+        raise ValueError(f"seeds must be distinct ints >= 0, got {seeds}")
+    for name, v in (
+        ("learn_time_s", learn_time_s),
+        ("max_homing_s", max_homing_s),
+        ("success_radius_m", success_radius_m),
+    ):
+        positive_float(name, v)
+    if relearn not in ("scene", "episode"):
+        raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
+    tracker = check_tracker_spec(tracker)
+    if agent == "pretrained":
+        from vc_gym.agents.learned import PRETRAINED_MODEL
+
+        agent = str(PRETRAINED_MODEL)
+    if agent != "scripted":
+        from vc_gym.agents.learned import LearnedHomingAgent
+
+        agent = str(Path(agent).resolve())
+        scene = LearnedHomingAgent(agent).scene  # a bad model fails here, not in a worker
+    else:
+        from vc_gym.envs.scenes import check_scene_name
+
+        check_scene_name(scene)
+
+    settings = {
+        "agent": "scripted" if agent == "scripted" else Path(agent).parent.name,
+        "tracker": tracker,
+        "scene": scene,
+        "seeds": seeds,
+        "episodes_per_seed": episodes,
+        "learn_time_s": learn_time_s,
+        "max_homing_s": max_homing_s,
+        "success_radius_m": success_radius_m,
+        "relearn": relearn,
+        "field": field,
+    }
+    run = open_run(out_dir, "homing", opts, settings)
+    specs = {s: atlas_spec(scene, s, "scripted", learn_time_s) for s in seeds}
+    atlases = (
+        ensure_atlases(run, list(specs.values()), opts.atlas_dir) if relearn == "scene" else {}
+    )
+    videos = run.out / "videos"
+    jobs = []
+    for s in seeds:
+        for i in range(episodes):
+            n = len(jobs)
+            kwargs = {
+                "agent": agent,
+                "tracker": tracker,
+                "scene": scene,
+                "learn_time_s": learn_time_s,
+                "success_radius_m": success_radius_m,
+                "max_homing_s": max_homing_s,
+                "atlas": atlases.get(atlas_key(specs[s])),
+                "learning_seed": s,
+                "episode_seed": s + 1 + i,
+            }
+            if n < opts.video:
+                kwargs["video"] = str((videos / f"seed{s}-episode{i:03d}.mp4").resolve())
+            jobs.append(Job(f"seed{s}-episode{i:03d}", f"{__name__}:episode_job", kwargs))
+    if opts.video:
+        videos.mkdir(exist_ok=True)
+    outputs = run.run("episodes", jobs)
+    done = [o for o in outputs if o is not None]
+    results: dict[str, Any] = {
+        "paper": {
+            "mean_stop_offset_cm": list(PAPER_MEAN_CM),
+            "std_stop_offset_cm": list(PAPER_STD_CM),
+            "episodes": 33,
+        },
+    }
+    per_seed = []
+    for s in seeds:
+        eps = [o for o in done if o["learning_seed"] == s]
+        if eps:
+            per_seed.append({"seed": s, **summarise_stops(eps, success_radius_m)})
+    results["per_seed"] = per_seed
+    if done:
+        overall = summarise_stops(done, success_radius_m)
+        if len(per_seed) > 1:
+            overall["success_rate_over_seeds"] = _mean_std([p["success_rate"] for p in per_seed])
+            overall["mean_stop_distance_cm_over_seeds"] = _mean_std(
+                [p["mean_stop_distance_cm"] for p in per_seed]
+            )
+        results["overall"] = overall
+        _plot_stops(run.out / "stop_positions.png", done, settings, overall)
+    if field and relearn == "scene":
+        results["likelihood_field"] = _likelihood_field(
+            run, opts, size, scene, atlases, specs[seeds[0]]
+        )
+    results["per_episode"] = done
+    costs = [t.get("tracker_ms_per_update") for t in run.timings.get("episodes", {}).values()]
+    costs = [c for c in costs if c is not None]
+    info = {"tracker_ms_per_update_median": float(np.median(costs)) if costs else None}
+    return run.finish(results, info)
+
+
+def _likelihood_field(run, opts, size, scene, atlases, spec) -> dict[str, Any]:
+    bounds = scene_field_bounds(scene)
+    grid = field_grid(bounds, size["field_spacing_m"], margin_m=0.0)
+    path = atlases[atlas_key(spec)]
+    rng = np.random.default_rng([opts.seed, 5])
+    jobs = []
+    for i, (x, y) in enumerate(grid):
+        headings = sorted(rng.uniform(0, 360, size["field_headings"]).round(3).tolist())
+        kwargs = {
+            "scene": scene,
+            "atlas": path,
+            "x": round(float(x), 4),
+            "y": round(float(y), 4),
+            "headings": headings,
+            "frames": size["field_frames"],
+            "seed": int(opts.seed * 100_000 + i * 100),
+        }
+        jobs.append(Job(f"field-{i:04d}", f"{__name__}:field_job", kwargs))
+    outputs = [o for o in run.run("field", jobs) if o is not None]
+    names = list(outputs[0]["goodness"]) if outputs else []
+    field_out = {
+        "learning_seed": spec["seed"],
+        "spacing_m": size["field_spacing_m"],
+        "positions": [o["position"] for o in outputs],
+        "goodness": {n: [round(o["goodness"][n], 5) for o in outputs] for n in names},
+    }
+    if outputs:
+        spot = "east" if "east" in names else names[0]
+        loaded = CompassAtlas.load(path)
+        plot_goodness_field(
+            run.out / "likelihood_field.png",
+            np.array(field_out["positions"]),
+            np.array(field_out["goodness"][spot]),
+            tuple(loaded.positions[loaded.names.index(spot)]),
+            bounds,
+        )
+        field_out["plotted_spot"] = spot
+    return field_out
+
+
+def _plot_stops(path: Path, episodes, settings, overall) -> None:
+    from matplotlib.patches import Circle
+
+    fig = new_figure(figsize=(6, 5), layout="constrained")
+    ax = fig.subplots()
+    seeds = sorted({e["learning_seed"] for e in episodes})
+    for s in seeds:
+        off = np.array([e["stop_offset_m"] for e in episodes if e["learning_seed"] == s]) * 100
+        ax.scatter(off[:, 0], off[:, 1], s=22, label=f"stops, learning seed {s}")
+    for x, y in ((100, 0), (0, 100), (-100, 0), (0, -100)):
+        ax.plot(x, y, "x", color="goldenrod", ms=10, mew=3)
+    ax.plot(0, 0, "+", color="k", ms=14, mew=2, label="home")
+    m = overall["mean_stop_offset_cm"]
+    ax.plot(*m, "o", mfc="none", mec="tab:red", ms=12, mew=2, label=f"mean ({m[0]}, {m[1]}) cm")
+    ax.plot(*PAPER_MEAN_CM, "s", mfc="none", mec="k", ms=10, label="paper's mean (−22, 12) cm")
+    ax.add_patch(
+        Circle((0, 0), settings["success_radius_m"] * 100, fill=False, ls="--", color="0.5")
+    )
+    off = np.array([e["stop_offset_m"] for e in episodes]) * 100
+    lim = max(150.0, float(np.abs(off).max()) + 20.0) if off.size else 150.0
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x offset from home (cm)")
+    ax.set_ylabel("y offset from home (cm)")
+    tracker = settings["tracker"] if isinstance(settings["tracker"], str) else "custom"
+    ax.set_title(
+        f"{settings['agent']} ({tracker} tracker), {overall['episodes']} kidnappings:\n"
+        f"success {overall['success_rate']:.0%}, mean distance "
+        f"{overall['mean_stop_distance_cm']:.0f} cm, {overall['far_stops']} stops > 50 cm",
+        fontsize=10,
+    )
+    ax.legend(fontsize=7, loc="upper right")
+    save_figure(fig, path, dpi=100)
+
+
+def summary_lines(results: dict[str, Any]) -> list[str]:
+    """The homing result in a few lines, next to the paper's."""
+    lines = []
+    for p in results.get("per_seed", []):
+        lines.append(
+            f"learning seed {p['seed']}: {p['episodes']} kidnappings, mean stop offset "
+            f"{p['mean_stop_offset_cm']} cm, std {p['std_stop_offset_cm']} cm, mean distance "
+            f"{p['mean_stop_distance_cm']} cm, success {p['success_rate']:.0%}, "
+            f"{p['far_stops']} stops > 50 cm"
+        )
+    o = results.get("overall")
+    if o and len(results.get("per_seed", [])) > 1:
+        s, d = o["success_rate_over_seeds"], o["mean_stop_distance_cm_over_seeds"]
+        lines.append(
+            f"over {len(results['per_seed'])} learning seeds: success {s[0]:.0%} ± {s[1]:.0%}, "
+            f"mean distance {d[0]:.1f} ± {d[1]:.1f} cm (mean ± std over seeds)"
+        )
+    lines.append("paper: mean stop offset (-22, 12) cm, std (17, 15) cm over 33 kidnappings")
+    for f in results.get("failed_jobs", []):
+        lines.append(f"FAILED {f['stage']}/{f['key']}: {f['error']}")
+    return lines

@@ -1,0 +1,414 @@
+"""The paper's orientation experiment (5.1, fig. 4): heading over the field from one spot.
+
+The robot learns the panorama at a single spot (the paper: the centre of the rear
+field half) in a full turn, and is then put by hand at every point of a grid over the
+field (~33 cm spacing) with several random headings; at each pose it stands scanning
+with its head for some frames while every tracker (and the single-frame compass)
+estimates its heading. Each grid position is one job. The results give the heading
+error and spread against the distance from the training spot (fig. 4 right; the
+paper: the mean error exceeds 10° only beyond 2 m) and the arrow field of the heading
+estimates (fig. 4 left).
+
+:func:`view_job` and :func:`views_summary` are shared by the environments, parameter,
+illumination and tracker experiments.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
+from vc_gym.experiments.runner import ExperimentRun, Job, worker_cache
+from vc_gym.experiments.studies.common import (
+    ExperimentOptions,
+    open_run,
+    pick_size,
+    scene_field_bounds,
+)
+from vc_gym.experiments.views import (
+    COMPASS,
+    PAPER_ERROR_DEG,
+    PAPER_RANGE_M,
+    distance_table,
+    evaluate_view,
+    field_grid,
+    look,
+    plot_arrow_field,
+    plot_error_vs_distance,
+    view_poses,
+)
+from vc_gym.localization import make_tracker
+
+__all__ = [
+    "DEFAULT_TRACKERS",
+    "rear_half_centre",
+    "run_environments",
+    "run_orientation",
+    "summary_lines",
+    "view_job",
+    "view_jobs",
+    "views_summary",
+]
+
+DEFAULT_TRACKERS = ("grid", "kalman", "particle")
+
+SIZES = {
+    "quick": {"spacing_m": 2.0, "headings": 1, "frames": 4, "learn_time_s": 0.5},
+    "paper": {"spacing_m": 0.5, "headings": 2, "frames": 10, "learn_time_s": 5.0},
+    "full": {"spacing_m": 0.33, "headings": 3, "frames": 15, "learn_time_s": 5.0},
+}
+
+
+def rear_half_centre(bounds: Sequence[float]) -> tuple[float, float]:
+    """The centre of the field half with x < centre: the paper's training spot (5.1)."""
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    return (round(x0 + (x1 - x0) / 4.0, 4), round((y0 + y1) / 2.0, 4))
+
+
+def check_trackers(trackers: Sequence[Any] | Mapping[str, Any]) -> dict[str, Any]:
+    """``{name: spec}`` of trackers that can travel to workers (names must be unique)."""
+    if isinstance(trackers, Mapping):
+        named = dict(trackers)
+    else:
+        named = {}
+        for spec in trackers:
+            if isinstance(spec, str):
+                name = spec
+            elif isinstance(spec, Mapping) and "type" in spec:
+                name = json.dumps(dict(spec), sort_keys=True, separators=(",", ":"))
+            else:
+                raise ValueError(
+                    "a tracker of an experiment must be a name, 'package.module:factory' or "
+                    f'a {{"type": ...}} dict (the jobs run in other processes), got {spec!r}'
+                )
+            if name in named:
+                raise ValueError(f"tracker {name!r} given twice")
+            named[name] = spec
+    if not named:
+        raise ValueError("no trackers given")
+    if COMPASS in named:
+        raise ValueError(f"{COMPASS!r} is always reported (the single-frame compass)")
+    for spec in named.values():
+        make_tracker(spec)  # an unknown tracker fails here, not in a worker
+    return json.loads(json.dumps(named))
+
+
+def view_job(
+    scene: str,
+    atlas: str,
+    spot: list[float],
+    poses: list[list[float]],
+    frames: int,
+    seed: int,
+    trackers: dict[str, Any],
+    room: dict[str, Any] | None = None,
+    time_learning: bool = False,
+) -> dict[str, Any]:
+    """Job: stand at every pose of one grid position; what each tracker believed.
+
+    Returns ``{"views": [{"pose", "distance_m", "estimates": {tracker: {...}}}],
+    "timing": {tracker: ms per update}}``; with ``time_learning`` the timing also holds
+    ``"learn"``: milliseconds to learn one frame into a map of the atlas' config.
+    """
+    from vc_gym.envs.aibo_room import AiboRoomEnv
+
+    room = dict(room or {})
+    env = worker_cache(
+        ("room", scene, json.dumps(room, sort_keys=True)),
+        lambda: AiboRoomEnv(scene=scene, **room),
+    )
+    loaded = worker_cache(("atlas", atlas), lambda: CompassAtlas.load(atlas))
+    camera = Camera(hfov_deg=env.camera.hfov_deg)
+    views, costs = [], {}
+    for k, pose in enumerate(poses):
+        seen = look(env, tuple(pose), frames, seed=seed + k)
+        figures, timing = evaluate_view(seen, loaded, camera, env.control_dt, pose[2], trackers)
+        views.append(
+            {
+                "pose": [round(float(v), 4) for v in pose],
+                "distance_m": round(math.hypot(pose[0] - spot[0], pose[1] - spot[1]), 4),
+                "estimates": {
+                    name: {k2: round(v, 4) for k2, v in est.items()}
+                    for name, est in figures.items()
+                },
+            }
+        )
+        for name, ms in timing.items():
+            costs.setdefault(name, []).append(ms)
+        if time_learning:
+            costs.setdefault("learn", []).append(_learn_ms(loaded, seen, camera, pose[2]))
+    return {"views": views, "timing": {n: float(np.median(v)) for n, v in costs.items()}}
+
+
+def _learn_ms(atlas: CompassAtlas, frames, camera: Camera, heading_deg: float) -> float:
+    """Milliseconds per frame to learn ``frames`` into a fresh map (paper 5.3: 4 ms)."""
+    import time
+
+    from vc_gym.compass import VisualCompass
+
+    vc = VisualCompass(atlas.compasses[0].config, atlas.compasses[0].colors)
+    t0 = time.perf_counter()
+    for image, pan, _ in frames:
+        vc.learn(image, camera.replace(yaw_deg=heading_deg + pan))
+    return 1e3 * (time.perf_counter() - t0) / len(frames)
+
+
+def view_jobs(
+    prefix: str,
+    scene: str,
+    atlas: str,
+    spot: tuple[float, float],
+    bounds: Sequence[float],
+    size: Mapping[str, Any],
+    seed: int,
+    trackers: Mapping[str, Any],
+    room: Mapping[str, Any] | None = None,
+    time_learning: bool = False,
+) -> list[Job]:
+    """One :func:`view_job` per grid position (seeded poses, ``size``'s grid)."""
+    grid = field_grid(tuple(bounds), size["spacing_m"])
+    rng = np.random.default_rng([seed, 51])
+    poses = view_poses(grid, size["headings"], rng)
+    jobs = []
+    for i in range(len(grid)):
+        mine = poses[i * size["headings"] : (i + 1) * size["headings"]]
+        kwargs = {
+            "scene": scene,
+            "atlas": atlas,
+            "spot": list(spot),
+            "poses": [[round(float(v), 4) for v in p] for p in mine],
+            "frames": size["frames"],
+            "seed": int(seed * 1_000_000 + i * 100),
+            "trackers": dict(trackers),
+            "room": dict(room or {}),
+            "time_learning": time_learning,
+        }
+        jobs.append(Job(f"{prefix}{i:04d}", f"{__name__}:view_job", kwargs))
+    return jobs
+
+
+def views_summary(
+    outputs: Sequence[Mapping[str, Any] | None], names: Sequence[str]
+) -> dict[str, Any]:
+    """Per tracker: the distance table (fig. 4 right) and errors within / beyond 2 m."""
+    views = [v for o in outputs if o is not None for v in o["views"]]
+    out: dict[str, Any] = {"views": len(views), "trackers": {}}
+    if not views:
+        return out
+    dist = np.array([v["distance_m"] for v in views])
+    near = dist <= PAPER_RANGE_M
+    for name in (*names, COMPASS):
+        err = np.array([v["estimates"][name]["heading_error_deg"] for v in views])
+        spread = np.array([v["estimates"][name]["heading_spread_deg"] for v in views])
+        table = distance_table(dist, err, spread, bin_m=0.5)
+        near_bins = [b for b in table if b["bin_end_m"] <= PAPER_RANGE_M + 1e-9]
+        out["trackers"][name] = {
+            "mean_abs_error_deg": round(float(np.abs(err).mean()), 2),
+            "median_abs_error_deg": round(float(np.median(np.abs(err))), 2),
+            "mean_abs_error_within_2m_deg": round(float(np.abs(err[near]).mean()), 2)
+            if near.any()
+            else None,
+            "mean_abs_error_beyond_2m_deg": round(float(np.abs(err[~near]).mean()), 2)
+            if (~near).any()
+            else None,
+            "within_10deg": round(float(np.mean(np.abs(err) <= 10.0)), 4),
+            "paper_claim_holds": bool(near_bins)
+            and all(b["mean_abs_error_deg"] < PAPER_ERROR_DEG for b in near_bins),
+            "by_distance": [{k: _round(v) for k, v in b.items()} for b in table],
+        }
+    return out
+
+
+def _round(v: Any) -> Any:
+    return round(float(v), 3) if isinstance(v, float) else v
+
+
+def plot_views(
+    folder: Path,
+    outputs: Sequence[Mapping[str, Any] | None],
+    summary: Mapping[str, Any],
+    spot: tuple[float, float],
+    bounds: Sequence[float],
+    title: str,
+    arrows_for: str = "grid",
+    suffix: str = "",
+) -> None:
+    """``error_vs_distance{suffix}.png`` and ``arrow_field{suffix}.png``."""
+    views = [v for o in outputs if o is not None for v in o["views"]]
+    if not views:
+        return
+    tables = {n: s["by_distance"] for n, s in summary["trackers"].items()}
+    plot_error_vs_distance(folder / f"error_vs_distance{suffix}.png", tables)
+    name = arrows_for if arrows_for in summary["trackers"] else next(iter(summary["trackers"]))
+    poses = np.array([v["pose"] for v in views])
+    headings = np.array([v["estimates"][name]["heading_deg"] for v in views])
+    plot_arrow_field(
+        folder / f"arrow_field{suffix}.png",
+        poses,
+        headings,
+        spot,
+        tuple(bounds),
+        f"{title}: {name} heading estimates",
+        reference_deg=0.0,  # as in fig. 4: every correct arrow points to +x
+    )
+
+
+def orientation_stage(
+    run: ExperimentRun,
+    opts: ExperimentOptions,
+    size: Mapping[str, Any],
+    scene: str,
+    trackers: Mapping[str, Any],
+    compass: Mapping[str, Any] | None = None,
+    room: Mapping[str, Any] | None = None,
+    stage: str | None = None,
+    time_learning: bool = False,
+) -> tuple[list[dict[str, Any] | None], dict[str, Any], tuple[float, float], tuple]:
+    """Learn one spot in ``scene`` with ``compass`` and run the view jobs in ``room``.
+
+    The atlas is learned at full light (``room`` applies to the views only).
+    """
+    bounds = scene_field_bounds(scene)
+    spot = rear_half_centre(bounds)
+    spec = atlas_spec(scene, opts.seed, "spot", size["learn_time_s"], compass, spot=spot)
+    atlas_path = ensure_atlases(run, [spec], opts.atlas_dir)[atlas_key(spec)]
+    jobs = view_jobs(
+        "pos-", scene, atlas_path, spot, bounds, size, opts.seed, trackers, room, time_learning
+    )
+    outputs = run.run(stage or f"views-{scene}", jobs)
+    return outputs, views_summary(outputs, list(trackers)), spot, bounds
+
+
+def run_orientation(
+    out_dir: str | os.PathLike,
+    opts: ExperimentOptions | None = None,
+    trackers: Sequence[Any] | None = None,
+    scenes: Sequence[str] | None = None,
+) -> dict[str, Any]:
+    """Run the orientation experiment (5.1, fig. 4) and write its results and plots.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        The run folder (resumable).
+    opts : ExperimentOptions
+        Seed, size (grid spacing, headings and frames per position), backend, ...
+    trackers : sequence, optional
+        Tracker specs (default: grid, kalman, particle); the single-frame compass is
+        always reported as ``"compass"``.
+    scenes : sequence of str, optional
+        Default ``["robolab"]`` (the paper's); one spot per scene.
+
+    Returns
+    -------
+    dict
+        The results written to ``results.json``.
+    """
+    return _run_views("orientation", out_dir, opts, trackers, scenes or ["robolab"])
+
+
+def run_environments(
+    out_dir: str | os.PathLike,
+    opts: ExperimentOptions | None = None,
+    trackers: Sequence[Any] | None = None,
+    scenes: Sequence[str] | None = None,
+) -> dict[str, Any]:
+    """The orientation experiment in every registered scene (paper 5.3: other places).
+
+    Same parameters as :func:`run_orientation`; ``scenes`` defaults to every scene
+    registered in this process (:func:`vc_gym.envs.scenes.scene_names`; a scene a user
+    registered must also be registered in the workers, see that package).
+    """
+    from vc_gym.envs.scenes import scene_names
+
+    return _run_views("environments", out_dir, opts, trackers, scenes or list(scene_names()))
+
+
+def _run_views(name, out_dir, opts, trackers, scenes) -> dict[str, Any]:
+    opts = opts or ExperimentOptions()
+    size = pick_size(SIZES, opts.size)
+    named = check_trackers(trackers or DEFAULT_TRACKERS)
+    scenes = _check_scenes(scenes)
+    run = open_run(out_dir, name, opts, {"trackers": named, "scenes": scenes, **size})
+    results: dict[str, Any] = {
+        "paper": {"claim": "mean heading error < 10° within 2 m of the training spot"},
+        "scenes": {},
+    }
+    for scene in scenes:
+        outputs, summary, spot, bounds = orientation_stage(run, opts, size, scene, named)
+        suffix = "" if len(scenes) == 1 else f"_{scene}"
+        plot_views(run.out, outputs, summary, spot, bounds, f"{scene}, spot {spot}", suffix=suffix)
+        results["scenes"][scene] = {"training_spot": list(spot), **summary}
+    if len(scenes) > 1:
+        _plot_scenes(run.out / "scenes.png", results["scenes"])
+    return run.finish(results, _cost_info(run))
+
+
+def _plot_scenes(path: Path, per_scene: Mapping[str, Any], tracker: str = "grid") -> None:
+    """Mean |heading error| vs distance, one line per scene (for one tracker)."""
+    from vc_gym.experiments.output import new_figure, save_figure
+
+    fig = new_figure(figsize=(6.5, 4), layout="constrained")
+    ax = fig.subplots()
+    for scene, r in per_scene.items():
+        t = r["trackers"].get(tracker) or next(iter(r["trackers"].values()))
+        rows = t["by_distance"]
+        ax.plot(
+            [b["distance_m"] for b in rows],
+            [b["mean_abs_error_deg"] for b in rows],
+            "o-",
+            label=scene,
+        )
+    ax.axhline(PAPER_ERROR_DEG, ls="--", color="0.4", lw=1)
+    ax.axvline(PAPER_RANGE_M, ls=":", color="0.4", lw=1)
+    ax.set_xlabel("distance from the training spot (m)")
+    ax.set_ylabel(f"mean |heading error| (°), {tracker} tracker")
+    ax.set_yscale("log")
+    ax.set_title("the orientation experiment in every scene (paper 5.3)", fontsize=10)
+    ax.legend(fontsize=8)
+    save_figure(fig, path)
+
+
+def _check_scenes(scenes: Sequence[str]) -> list[str]:
+    from vc_gym.envs.scenes import check_scene_name
+
+    out = [check_scene_name(s) for s in scenes]
+    if len(set(out)) != len(out):
+        raise ValueError(f"scenes given twice: {out}")
+    return out
+
+
+def _cost_info(run: ExperimentRun) -> dict[str, Any]:
+    """Median ms per update of every tracker over all view jobs (for ``run.json``)."""
+    costs: dict[str, list[float]] = {}
+    for stage, jobs in run.timings.items():
+        if not stage.startswith("views"):
+            continue
+        for timing in jobs.values():
+            for name, ms in timing.items():
+                costs.setdefault(name, []).append(ms)
+    return {"ms_per_update_median": {n: round(float(np.median(v)), 3) for n, v in costs.items()}}
+
+
+def summary_lines(results: Mapping[str, Any]) -> list[str]:
+    """Mean heading error within and beyond 2 m of the spot, per scene and tracker."""
+    lines = []
+    for scene, r in results.get("scenes", {}).items():
+        lines.append(f"{scene} (spot {r['training_spot']}, {r['views']} views):")
+        for name, t in r["trackers"].items():
+            lines.append(
+                f"  {name:10s} mean |error| {t['mean_abs_error_within_2m_deg']}° within 2 m, "
+                f"{t['mean_abs_error_beyond_2m_deg']}° beyond; paper's claim (< 10° within "
+                f"2 m) {'holds' if t['paper_claim_holds'] else 'does not hold'}"
+            )
+    for f in results.get("failed_jobs", []):
+        lines.append(f"FAILED {f['stage']}/{f['key']}: {f['error']}")
+    return lines
