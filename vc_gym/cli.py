@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import textwrap
 import json
 import sys
 from collections.abc import Iterator, Sequence
@@ -125,6 +126,20 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                     f"{v['final_heading_error_deg']:.1f}°, position error "
                     f"{v['final_position_error_m'] * 100:.0f} cm"
                 )
+    elif args.what == "backends":
+        from vc_gym.experiments.bench_backends import bench_backends
+
+        result = bench_backends(
+            episodes=args.episodes, workers=args.workers, seed=args.seed, progress=not args.json
+        )
+        if not args.json:
+            for name, r in result["runs"].items():
+                ratio = result["speedup_vs_one_local_worker"].get(name, 1.0)
+                print(
+                    f"{name:8s} {r['jobs_per_s']:6.3f} jobs/s ({r['jobs']} homing episodes in "
+                    f"{r['wall_s']:.0f} s), x{ratio:.2f} of one local worker"
+                )
+            print(f"byte-identical results.json on every backend: {result['identical_results']}")
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:
@@ -377,18 +392,28 @@ def build_parser() -> argparse.ArgumentParser:
             "second of vc_gym/AiboRoom-v0 next to bare PyBullet doing the same physics and "
             "render, and the speed-up of 2 async envs. trackers: cost of one update of every "
             "registered tracker (grid, particle, kalman) on the same walk through a ray-cast "
-            "room with a 4-spot atlas, next to the atlas alone. The last line of --json output "
-            "is one JSON object."
+            "room with a 4-spot atlas, next to the atlas alone. backends: jobs per second of "
+            "the homing experiment's episodes with 1 local worker, --workers local workers and "
+            "a local Ray instance of --workers CPUs (atlas learned once; the results must be "
+            "byte-identical). The last line of --json output is one JSON object."
         ),
     )
     p.add_argument(
-        "what", choices=["compass", "filters", "env", "trackers"], help="what to benchmark"
+        "what",
+        choices=["compass", "filters", "env", "trackers", "backends"],
+        help="what to benchmark",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
     p.add_argument("--frames", type=int, default=40, help="compass: distinct test frames")
     p.add_argument("--repeats", type=int, default=15, help="timed rounds (medians are reported)")
     p.add_argument("--plot", metavar="PNG", help="filters: save a plot of the tracking run")
+    p.add_argument(
+        "--episodes", type=int, default=12, help="backends: homing episodes (jobs) per backend"
+    )
+    p.add_argument(
+        "--workers", type=int, default=2, help="backends: workers of the parallel backends"
+    )
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=_cmd_bench)
 
@@ -500,23 +525,38 @@ def build_parser() -> argparse.ArgumentParser:
 
     from vc_gym.experiments.studies import EXPERIMENTS, SIZES
 
-    listing = "; ".join(f"{name}: {e.help}" for name, e in EXPERIMENTS.items())
+    def entry(name: str, text: str) -> str:
+        return textwrap.fill(f"{name}: {text}", 88, subsequent_indent="    ")
+
+    listing = "\n".join(entry(name, e.help) for name, e in EXPERIMENTS.items())
     p = sub.add_parser(
         "experiment",
         help="the paper's experiments, the tracker benchmark, and evaluations on real data",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description=(
-            "Experiments split into independent jobs run by a backend (a local process pool "
-            "or Ray) and saved as they finish: rerunning the same command in the same --out "
-            "resumes an interrupted run. Each writes DIR/results.json (figures only: the same "
-            "seed gives the same bytes on any backend), DIR/run.json (timings, jobs per "
-            "second, backend, versions) and its plots. Learned atlases are saved in "
-            "DIR/atlases and reused by every job.\n\n"
+            textwrap.fill(
+                "Experiments split into independent jobs run by a backend (a local process "
+                "pool or Ray) and saved as they finish: rerunning the same command in the "
+                "same --out resumes an interrupted run. Each writes DIR/results.json (figures "
+                "only: the same seed gives the same bytes on any backend), DIR/run.json "
+                "(timings, jobs per second, backend, versions) and its plots. Learned atlases "
+                "are saved in DIR/atlases and reused by every job.",
+                88,
+            )
+            + "\n\n"
             + listing
-            + "; real-rotation: learn from 9 alternate photos of a camera turning in place "
-            "and estimate the yaw of crops of the other 9 (indoor and outdoor sets, 10 and 3 "
-            "colour classes, without and with exposure normalisation); synthetic-compass: "
-            "synthetic room and outdoor panoramas at normal and half illumination."
+            + "\n"
+            + entry(
+                "real-rotation",
+                "learn from 9 alternate photos of a camera turning in place and estimate the "
+                "yaw of crops of the other 9 (indoor and outdoor sets, 10 and 3 colour "
+                "classes, without and with exposure normalisation)",
+            )
+            + "\n"
+            + entry(
+                "synthetic-compass",
+                "synthetic room and outdoor panoramas at normal and half illumination",
+            )
         ),
     )
     p.add_argument(

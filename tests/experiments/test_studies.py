@@ -163,3 +163,14 @@ def test_an_output_that_is_a_file_is_refused_at_once(tmp_path, capsys):
     assert main(["experiment", "homing", "--out", str(tmp_path / "taken"), "--quick"]) == 2
     assert "not a folder" in capsys.readouterr().err
     assert (tmp_path / "taken").read_text() == "mine"
+
+
+def test_bench_backends_measures_every_backend_on_the_same_jobs():
+    from vc_gym.experiments.bench_backends import bench_backends
+
+    r = bench_backends(episodes=2, learn_time_s=0.3, max_homing_s=8.0, progress=False)
+    expected = {"local-1", "local-2"} | ({"ray-2"} if r["ray"] else set())
+    assert set(r["runs"]) == expected
+    assert all(run["jobs"] == 2 and run["jobs_per_s"] > 0 for run in r["runs"].values())
+    assert set(r["speedup_vs_one_local_worker"]) == expected - {"local-1"}
+    assert r["identical_results"]
