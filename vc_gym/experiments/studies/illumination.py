@@ -22,7 +22,13 @@ from vc_gym.experiments.studies.common import (
     pick_size,
     scene_field_bounds,
 )
-from vc_gym.experiments.studies.orientation import rear_half_centre, view_jobs, views_summary
+from vc_gym.experiments.studies.orientation import (
+    headline_errors,
+    one_scene,
+    rear_half_centre,
+    view_jobs,
+    views_summary,
+)
 from vc_gym.experiments.views import COMPASS
 
 __all__ = ["LEVELS", "MODES", "run_illumination", "summary_lines"]
@@ -61,10 +67,7 @@ def run_illumination(
     """
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
-    scenes = list(scenes or ["robolab"])
-    if len(scenes) != 1:
-        raise ValueError(f"the illumination study runs in one scene, got {scenes}")
-    scene = scenes[0]
+    scene = one_scene(scenes, "illumination study")
     run = open_run(out_dir, "illumination", opts, {"scene": scene, "levels": list(LEVELS), **size})
     bounds = scene_field_bounds(scene)
     spot = rear_half_centre(bounds)
@@ -96,17 +99,7 @@ def run_illumination(
             )
             s = views_summary(run.run(f"views-{mode}-{level}", jobs), list(TRACKERS))
             row = {"illumination": level, "views": s["views"]}
-            for name in (COMPASS, *TRACKERS):
-                t = s["trackers"].get(name, {})
-                row[name] = {
-                    k: t.get(k)
-                    for k in (
-                        "mean_abs_error_deg",
-                        "median_abs_error_deg",
-                        "mean_abs_error_within_2m_deg",
-                        "within_10deg",
-                    )
-                }
+            row.update(headline_errors(s, list(TRACKERS)))
             rows.append(row)
         results["modes"][mode] = rows
     _plot(run.out / "illumination.png", results["modes"])

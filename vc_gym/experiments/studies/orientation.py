@@ -49,6 +49,9 @@ from vc_gym.localization import make_tracker
 
 __all__ = [
     "DEFAULT_TRACKERS",
+    "HEADLINE",
+    "headline_errors",
+    "one_scene",
     "rear_half_centre",
     "run_environments",
     "run_orientation",
@@ -225,6 +228,32 @@ def views_summary(
             "by_distance": [{k: _round(v) for k, v in b.items()} for b in table],
         }
     return out
+
+
+#: The figures a parameter or light-level row keeps of :func:`views_summary`.
+HEADLINE = (
+    "mean_abs_error_deg",
+    "median_abs_error_deg",
+    "mean_abs_error_within_2m_deg",
+    "within_10deg",
+)
+
+
+def headline_errors(summary: Mapping[str, Any], names: Sequence[str]) -> dict[str, Any]:
+    """``{name: {figure: value}}`` of the :data:`HEADLINE` figures, compass included."""
+    out = {}
+    for name in (COMPASS, *names):
+        t = summary["trackers"].get(name, {})
+        out[name] = {k: t.get(k) for k in HEADLINE}
+    return out
+
+
+def one_scene(scenes: Sequence[str] | None, experiment: str) -> str:
+    """The one scene of an experiment that runs in a single scene (default robolab)."""
+    scenes = list(scenes or ["robolab"])
+    if len(scenes) != 1:
+        raise ValueError(f"the {experiment} runs in one scene, got {scenes}")
+    return scenes[0]
 
 
 def _round(v: Any) -> Any:

@@ -30,6 +30,8 @@ from vc_gym.experiments.studies.common import (
     scene_field_bounds,
 )
 from vc_gym.experiments.studies.orientation import (
+    headline_errors,
+    one_scene,
     rear_half_centre,
     view_jobs,
     views_summary,
@@ -90,10 +92,7 @@ def run_params(
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
     sweeps = QUICK_PARAMETERS if opts.size == "quick" else PARAMETERS
-    scenes = list(scenes or ["robolab"])
-    if len(scenes) != 1:
-        raise ValueError(f"the parameter studies run in one scene, got {scenes}")
-    scene = scenes[0]
+    scene = one_scene(scenes, "parameter studies")
     run = open_run(
         out_dir,
         "params",
@@ -146,17 +145,7 @@ def run_params(
             label = _config_label(CompassConfig(**{param: v}).to_dict())
             s = summaries[label]
             row = {"value": v, "views": s["views"]}
-            for name in (COMPASS, *TRACKERS):
-                t = s["trackers"].get(name, {})
-                row[name] = {
-                    k: t.get(k)
-                    for k in (
-                        "mean_abs_error_deg",
-                        "median_abs_error_deg",
-                        "mean_abs_error_within_2m_deg",
-                        "within_10deg",
-                    )
-                }
+            row.update(headline_errors(s, list(TRACKERS)))
             rows.append(row)
         results["studies"][param] = rows
     _plot(run.out / "params.png", results["studies"], costs)
