@@ -11,6 +11,7 @@ import pytest
 
 from vc_gym.cli import main
 from vc_gym.experiments.studies import EXPERIMENTS
+from vc_gym.experiments.studies.paper import ORDER
 
 QUICK = ["--quick", "--seed", "0"]
 
@@ -32,7 +33,7 @@ def homing_quick(tmp_path_factory):
     return out
 
 
-@pytest.mark.parametrize("name", [n for n in EXPERIMENTS if n != "paper"])
+@pytest.mark.parametrize("name", ORDER)
 def test_every_experiment_wrote_its_files(paper_quick, name):
     folder = paper_quick / name
     results = json.loads((folder / "results.json").read_text())
@@ -46,6 +47,11 @@ def test_every_experiment_wrote_its_files(paper_quick, name):
     for word in ("seconds", "duration", "timing", "ms_per", str(paper_quick)):
         assert word not in text, word  # figures only: no timings, no paths
     assert list(folder.glob("*.png")), "no plot"
+
+
+def test_every_experiment_is_tested_end_to_end():
+    # the paper report runs ORDER; the others have end-to-end tests of their own
+    assert set(EXPERIMENTS) == {*ORDER, "paper", "localization"}
 
 
 def test_the_report_sets_our_figures_beside_the_papers(paper_quick):

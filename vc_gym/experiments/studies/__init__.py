@@ -76,6 +76,13 @@ EXPERIMENTS: dict[str, Experiment] = {
             "scenes x seeds on the homing task and the orientation grid, as a leaderboard",
         ),
         Experiment(
+            "localization",
+            _P + "localization",
+            "beyond the paper (5.2's open problem): maps on a grid of spots, position "
+            "error over the whole field of eq. 30 and of a likelihood calibrated on "
+            "goodness against distance",
+        ),
+        Experiment(
             "paper",
             _P + "paper",
             "all of the above at the report's size (< 20 min on 2 cores), writing "
