@@ -17,7 +17,13 @@ __all__ = ["main"]
 def _cmd_demo(args: argparse.Namespace) -> int:
     from vc_gym.experiments.demo import run_demo
 
-    s = run_demo(args.out, seed=args.seed, learn_time_s=args.learn_time, tracker=args.tracker)
+    s = run_demo(
+        args.out,
+        seed=args.seed,
+        learn_time_s=args.learn_time,
+        tracker=args.tracker,
+        mode=args.mode,
+    )
     dx, dy = (100 * v for v in s["stop_offset_m"])
     how = "stopped" if s["stopped"] else f"did not stop (timed out after {s['sim_time_s']:.0f} s),"
     print(
@@ -202,6 +208,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "max_homing_s": getattr(args, "max_homing", None),
         "relearn": getattr(args, "relearn", None),
         "field": getattr(args, "field", None),
+        "mode": getattr(args, "mode", None),
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -378,6 +385,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--learn-time", type=float, default=5.0, help="seconds per learning direction (paper: 5)"
     )
+    p.add_argument(
+        "--mode",
+        choices=["improved", "paper"],
+        default="improved",
+        help="improved (default): normalise the spots with the first turn's frames at the "
+        "true home; paper: after walking back home by odometry (the paper's procedure)",
+    )
     _add_tracker_option(p)
     p.set_defaults(func=_cmd_demo)
 
@@ -460,6 +474,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="homing seconds before an episode ends as timed out",
     )
     p.add_argument("--workers", type=int, default=2, help="parallel processes (1: in this process)")
+    p.add_argument(
+        "--mode",
+        choices=["paper", "improved"],
+        default="paper",
+        help="how the place is learned: paper (default) or improved (as the demo)",
+    )
     _add_tracker_option(p)
     p.add_argument(
         "--out", default="vc_gym_homing", metavar="DIR", help="output folder (resumable)"
@@ -613,6 +633,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--learn-time", type=float, help="seconds per learning direction")
     p.add_argument("--max-homing", type=float, metavar="S", help="homing time limit")
+    p.add_argument(
+        "--mode",
+        choices=["paper", "improved"],
+        help="homing: paper (the paper's learning phase, default) or improved (the spots "
+        "normalised with the frames of the first turn at the true home)",
+    )
     p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_experiment)

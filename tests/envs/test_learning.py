@@ -43,6 +43,7 @@ def test_kidnap_pose_lies_inside_the_margin():
         {"normalise_directions": 0},
         {"normalise_directions": 2.5},
         {"compass": "fast"},
+        {"normalise_at": "home"},
     ],
 )
 def test_bad_config(bad):
@@ -101,3 +102,25 @@ def test_spot_learning_gives_a_one_spot_normalised_atlas():
 def test_spot_learning_rejects_bad_spots(bad):
     with pytest.raises(ValueError, match="spot"):
         SpotLearning(bad)
+
+
+def test_normalising_with_the_first_turn_puts_home_at_the_true_home():
+    # "return" normalises where the odometry walk back ends (off the true home);
+    # "start" uses the first turn's frames, taken at the true home: a frame from the
+    # true home then fits every spot equally (goodness 1) and eq. 30 answers home
+    errors = {}
+    for where in ("return", "start"):
+        env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+        room = env.unwrapped
+        room.reset(seed=3, options={"pose": (0.0, 0.0, 0.0)})
+        config = LearningConfig(learn_time_s=0.3, normalise_at=where)
+        result = ScriptedLearner(room, config).learn()
+        camera = Camera(hfov_deg=room.camera.hfov_deg)
+        positions = []
+        for yaw in range(0, 360, 30):
+            obs, _ = room.reset(seed=9, options={"pose": (0.0, 0.0, float(yaw))})
+            positions.append(result.atlas.estimate_position(obs["image"], camera).position)
+        env.close()
+        errors[where] = float(np.hypot(*np.mean(positions, axis=0)))
+    assert errors["start"] < 0.05
+    assert errors["start"] < errors["return"]

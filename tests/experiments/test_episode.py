@@ -17,14 +17,17 @@ SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
 
 
 def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
-    demo = run_demo(tmp_path, seed=2, progress=False, **SHORT)
+    demo = run_demo(tmp_path, seed=2, progress=False, mode="improved", **SHORT)
     # the experiment learns the place in a job, saves the atlas and homes with the
     # loaded atlas: the same episode, so the atlas file is an exact round trip
     opts = ExperimentOptions(seed=2, backend=LocalBackend(1), progress=False)
-    evaluation = run_homing(tmp_path / "homing", opts, episodes=1, field=False, **SHORT)
+    evaluation = run_homing(
+        tmp_path / "homing", opts, episodes=1, field=False, mode="improved", **SHORT
+    )
     episode = evaluation["per_episode"][0]
     assert episode["seed"] == 3 and demo["learning_seed"] == 2
     assert {k: demo[k] for k in episode} == episode
+    assert demo["mode"] == evaluation["settings"]["mode"] == "improved"
     assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
 
 

@@ -103,7 +103,10 @@ class LearnThenHomeEnv(gym.Env):
     every reset. ``learner`` is any callable ``learner(room, config) ->
     LearningResult`` (``room``: the ``AiboRoomEnv`` just reset at home facing 0°,
     ``config``: the :class:`~vc_gym.envs.learning.LearningConfig` built from the
-    arguments); the result is kept as ``learning_result``.
+    arguments); the result is kept as ``learning_result``. ``normalise_at="return"``
+    (the paper) normalises the spots after walking back home by odometry;
+    ``"start"`` uses the frames of the first turn, taken at the true home (the stops
+    then lose the offset of the walk back's odometry drift).
 
     ## Info
 
@@ -136,6 +139,7 @@ class LearnThenHomeEnv(gym.Env):
         spot_radius_m: float = 0.25,
         compass: CompassConfig | None = None,
         learner: Learner | None = None,
+        normalise_at: str = "return",
         **room_kwargs: Any,
     ):
         if learning not in LEARNING_MODES:
@@ -178,6 +182,7 @@ class LearnThenHomeEnv(gym.Env):
             spot_distance_m=float(spot_distance_m),
             learn_time_s=float(learn_time_s),
             compass=compass if compass is not None else CompassConfig(),
+            normalise_at=normalise_at,
         )
         self.stop_time_s = float(stop_time_s)
         self.success_radius_m = float(success_radius_m)

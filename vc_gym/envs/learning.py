@@ -31,6 +31,7 @@ from vc_gym.validation import finite_float, positive_float
 __all__ = [
     "HEAD_SCAN_DEG",
     "HOME",
+    "NORMALISE_AT",
     "SPOT_NAMES",
     "Learner",
     "LearningConfig",
@@ -45,6 +46,8 @@ __all__ = [
 #: Home of the task: the world origin (robolab: the centre of the kickoff circle).
 HOME = (0.0, 0.0)
 SPOT_NAMES = ("east", "north", "west", "south")
+#: Where the learning phase normalises the spots (see :class:`LearningConfig`).
+NORMALISE_AT = ("return", "start")
 #: Head pans cycled while the robot learns a direction, and while it stands still homing.
 HEAD_SCAN_DEG = (-40.0, -20.0, 0.0, 20.0, 40.0, 20.0, 0.0, -20.0)
 
@@ -65,6 +68,13 @@ class LearningConfig:
         Learning time per direction (paper 4.3: 5 s).
     head_scan_deg : tuple of float
         Head pans cycled while learning a direction.
+    normalise_at : str
+        Where the spots' goodness is normalised (paper 5.2). ``"return"`` (the paper):
+        after the spots are learned the robot walks back home by odometry and takes
+        ``normalise_directions`` frames there; odometry drift puts it 15-20 cm from the
+        true home in the simulated robolab, and homing later stops where it
+        normalised. ``"start"``: the frames of the first full turn, taken at the true
+        home before the robot ever moved (no walk back).
     normalise_directions : int
         Directions at home whose frames normalise the goodness (paper 5.2).
     half_life_s : float
@@ -78,6 +88,7 @@ class LearningConfig:
     learn_time_s: float = 5.0
     head_scan_deg: tuple[float, ...] = HEAD_SCAN_DEG
     normalise_directions: int = 12
+    normalise_at: str = "return"
     half_life_s: float = 0.3
     compass: CompassConfig = field(default_factory=CompassConfig)
 
@@ -87,6 +98,10 @@ class LearningConfig:
         if not self.head_scan_deg or any(abs(p) > 90 for p in self.head_scan_deg):
             raise ValueError(
                 f"head_scan_deg must be non-empty pans within ±90°, got {self.head_scan_deg}"
+            )
+        if self.normalise_at not in NORMALISE_AT:
+            raise ValueError(
+                f"normalise_at must be one of {NORMALISE_AT}, got {self.normalise_at!r}"
             )
         n = self.normalise_directions
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
@@ -156,6 +171,7 @@ class ScriptedLearner:
         self.home_compass: VisualCompass | None = None
         self.learn_filter: HeadingGridFilter | None = None
         self.obs: dict | None = None
+        self._home_frames: list[np.ndarray] = []  # the first turn's images, at home
         self.info: dict | None = None
         #: true ``(x, y, yaw)`` of every frame of the last :meth:`learn_turn` (plots only)
         self.turn_path: list[tuple[float, float, float]] = []
@@ -303,9 +319,15 @@ class ScriptedLearner:
                     bar.update()
             compasses[name] = (spots[name], vc)
         bar.close()
-        self._walk_to(*HOME)
         atlas = CompassAtlas(compasses, home="home", home_position=HOME)
-        self._normalise(atlas)
+        if cfg.normalise_at == "start":
+            # every frame of the first turn: taken at the true home, all around, with
+            # the head scanning (many frames per heading: the home level is not noisy)
+            images = self._home_frames
+            atlas.normalize(images, [self.camera] * len(images))
+        else:
+            self._walk_to(*HOME)
+            self._normalise(atlas)
         return LearningResult(atlas, spots, path, self.rot_scale)
 
     def _learn_home(self, steps: int) -> None:
@@ -332,6 +354,7 @@ class ScriptedLearner:
         self._turn_to(start)
         for _ in range(3):
             self._act()
+        self._home_frames = [image for image, _, _, _ in frames]
         per_direction = {}
         for image, _, _, k in frames:
             per_direction.setdefault(k, image)

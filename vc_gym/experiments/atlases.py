@@ -39,6 +39,7 @@ def atlas_spec(
     compass: Mapping[str, Any] | None = None,
     spot: Sequence[float] | None = None,
     room: Mapping[str, Any] | None = None,
+    learning: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """What identifies a learned atlas (a JSON dict; see :func:`learn_atlas_job`).
 
@@ -59,13 +60,20 @@ def atlas_spec(
         The spot of the ``"spot"`` learner.
     room : mapping, optional
         Extra ``vc_gym/AiboRoom-v0`` options while learning (e.g. ``illumination``).
+    learning : mapping, optional
+        Learning options of ``vc_gym/LearnThenHome-v0`` that differ from the paper's
+        (``{"normalise_at": "start"}``).
     """
     if learner not in LEARNERS:
         raise ValueError(f"learner must be one of {LEARNERS}, got {learner!r}")
     if (learner == "spot") != (spot is not None):
         raise ValueError("spot is needed by, and only by, the 'spot' learner")
     config = CompassConfig(**dict(compass or {}))  # validates the fields
-    LearningConfig(learn_time_s=learn_time_s, compass=config)
+    learning = dict(learning or {})
+    unknown = set(learning) - {"normalise_at"}
+    if unknown:
+        raise ValueError(f"unknown learning options {sorted(unknown)}; known: ['normalise_at']")
+    LearningConfig(learn_time_s=learn_time_s, compass=config, **learning)
     spec = {
         "scene": str(scene),
         "seed": int(seed),
@@ -76,6 +84,8 @@ def atlas_spec(
     }
     if spot is not None:
         spec["spot"] = [float(v) for v in spot]
+    if learning:  # only when set: the paper's specs keep their keys
+        spec["learning"] = learning
     json.dumps(spec, allow_nan=False)  # JSON values only
     return spec
 
@@ -128,6 +138,7 @@ def learn_atlas_job(spec: dict[str, Any], path: str) -> dict[str, Any]:
         learn_time_s=spec["learn_time_s"],
         compass=CompassConfig(**spec["compass"]),
         **({"learner": _learner(spec)} if spec["learner"] != "scripted" else {}),
+        **spec.get("learning", {}),
         **spec["room"],
     )
     try:

@@ -24,7 +24,14 @@ from tqdm import tqdm
 from vc_gym.angles import wrap180
 from vc_gym.localization import TrackerSpec
 
-__all__ = ["EpisodeRecord", "EpisodeStep", "HomingRun", "make_homing_run", "run_episode"]
+__all__ = [
+    "HOMING_MODES",
+    "EpisodeRecord",
+    "EpisodeStep",
+    "HomingRun",
+    "make_homing_run",
+    "run_episode",
+]
 
 
 @dataclass
@@ -140,6 +147,17 @@ class HomingRun:
         self.env.close()
 
 
+#: How the place is learned, by name: task arguments of ``vc_gym/LearnThenHome-v0``.
+#: ``paper``: the paper's procedure (5.2), normalising the spots after walking back home
+#: by odometry, whose drift (15-20 cm in the simulated robolab) becomes the stops'
+#: systematic offset. ``improved``: normalising with every frame of the first turn,
+#: taken at the true home before the robot moved.
+HOMING_MODES: dict[str, dict[str, Any]] = {
+    "paper": {},
+    "improved": {"normalise_at": "start"},
+}
+
+
 def make_homing_run(
     agent: str = "scripted",
     tracker: TrackerSpec = "grid",
@@ -150,6 +168,7 @@ def make_homing_run(
     max_homing_s: float = 60.0,
     learner: Callable | None = None,
     keep_image: bool = False,
+    mode: str = "paper",
 ) -> HomingRun:
     """The homing task with the paper's 5 s stop rule, and an agent to run it.
 
@@ -172,7 +191,11 @@ def make_homing_run(
         agent's env turns its observation into a feature vector and has no frame to
         keep: this argument does not change it (the video renders the frame from the
         env instead, see :class:`~vc_gym.experiments.video.EpisodeVideo`).
+    mode : str
+        How the place is learned (:data:`HOMING_MODES`): ``"paper"`` or ``"improved"``.
     """
+    if mode not in HOMING_MODES:
+        raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
     from vc_gym.agents.scripted import ScriptedHomingPolicy
     from vc_gym.envs.compass_observation import CompassObservation
 
@@ -183,6 +206,7 @@ def make_homing_run(
         "stop_time_s": 5.0,  # the paper's rule, also for agents trained with a shorter one
         "success_radius_m": success_radius_m,
         "max_homing_s": max_homing_s,
+        **HOMING_MODES[mode],
     }
     if learner is not None:
         task["learner"] = learner

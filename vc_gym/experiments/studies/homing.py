@@ -23,7 +23,7 @@ import numpy as np
 
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.episode import make_homing_run, run_episode
+from vc_gym.experiments.episode import HOMING_MODES, make_homing_run, run_episode
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.runner import Job, worker_cache
 from vc_gym.experiments.studies.common import (
@@ -40,6 +40,8 @@ __all__ = ["PAPER_MEAN_CM", "PAPER_STD_CM", "run_homing", "episode_job", "summar
 
 PAPER_MEAN_CM = (-22.0, 12.0)
 PAPER_STD_CM = (17.0, 15.0)
+#: How the place is learned, by name (see :data:`~vc_gym.experiments.episode.HOMING_MODES`).
+MODES = HOMING_MODES
 #: A stop this far from home is a "far stop": the robot trusted a position it had no
 #: evidence for (or never found home).
 FAR_STOP_M = 0.5
@@ -199,6 +201,7 @@ def run_homing(
     success_radius_m: float = 0.3,
     relearn: str = "scene",
     field: bool = True,
+    mode: str = "paper",
 ) -> dict[str, Any]:
     """Run the homing experiment and write ``results.json``, ``run.json`` and plots.
 
@@ -228,6 +231,8 @@ def run_homing(
         anew in every episode (slow).
     field : bool
         Also measure the likelihood field of fig. 5 (right).
+    mode : str
+        ``"paper"`` or ``"improved"`` (:data:`MODES`: how the place is learned).
 
     Returns
     -------
@@ -252,6 +257,10 @@ def run_homing(
         positive_float(name, v)
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {list(MODES)}, got {mode!r}")
+    if mode != "paper" and relearn != "scene":
+        raise ValueError("mode applies to the saved atlases: use relearn='scene'")
     tracker = check_tracker_spec(tracker)
     if agent == "pretrained":
         from vc_gym.agents.learned import PRETRAINED_MODEL
@@ -278,9 +287,10 @@ def run_homing(
         "success_radius_m": success_radius_m,
         "relearn": relearn,
         "field": field,
+        **({"mode": mode} if mode != "paper" else {}),
     }
     run = open_run(out_dir, "homing", opts, settings)
-    specs = {s: atlas_spec(scene, s, "scripted", learn_time_s) for s in seeds}
+    specs = {s: atlas_spec(scene, s, "scripted", learn_time_s, learning=MODES[mode]) for s in seeds}
     atlases = (
         ensure_atlases(run, list(specs.values()), opts.atlas_dir) if relearn == "scene" else {}
     )
@@ -418,7 +428,8 @@ def _plot_stops(path: Path, episodes, settings, overall) -> None:
 
 def summary_lines(results: dict[str, Any]) -> list[str]:
     """The homing result in a few lines, next to the paper's."""
-    lines = []
+    mode = results.get("settings", {}).get("mode", "paper")
+    lines = [f"mode: {mode} (how the place is learned)"]
     for p in results.get("per_seed", []):
         lines.append(
             f"learning seed {p['seed']}: {p['episodes']} kidnappings, mean stop offset "
