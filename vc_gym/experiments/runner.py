@@ -168,8 +168,14 @@ def worker_cache(key: Any, make: Callable[[], Any], limit: int = 4) -> Any:
     return value
 
 
-def _init_worker() -> None:
+def _init_worker(quiet: bool = False) -> None:
     os.environ.update(SINGLE_THREADED)
+    if quiet:
+        # native libraries print to the process' stdout (PyBullet: "argv[0]=", its build
+        # time) and would scribble over the parent's progress bar; jobs return data
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
     try:
         import cv2
 
@@ -217,7 +223,10 @@ class LocalBackend:
             os.environ.update(SINGLE_THREADED)  # spawned workers read it when numpy loads
             try:
                 self._executor = cf.ProcessPoolExecutor(
-                    self.workers, mp_context=mp.get_context("spawn"), initializer=_init_worker
+                    self.workers,
+                    mp_context=mp.get_context("spawn"),
+                    initializer=_init_worker,
+                    initargs=(True,),
                 )
                 # start the workers now, while the environment is single-threaded
                 list(self._executor.map(_noop, range(self.workers)))
