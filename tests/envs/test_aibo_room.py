@@ -153,6 +153,18 @@ def test_render_rgb_array_shape():
     env.close()
 
 
+def test_the_top_views_background_does_not_keep_the_robot_where_it_first_stood():
+    backgrounds = []
+    for pose in ((1.0, 1.0, 0.0), (-1.5, -1.0, 90.0)):
+        env = make("vc_gym/AiboRoom-v0", render_mode="rgb_array")
+        env.reset(seed=0, options={"pose": pose})
+        env.render()  # the first render draws the background
+        backgrounds.append(env.unwrapped._top_view.background.copy())
+        assert env.unwrapped.robot._visible  # shown again after the background
+        env.close()
+    np.testing.assert_array_equal(backgrounds[0], backgrounds[1])
+
+
 def test_render_human_without_display_is_a_clear_error(monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     with pytest.raises(RuntimeError, match="display"):

@@ -362,9 +362,15 @@ class AiboRoomEnv(gym.Env):
             return None
         if self.render_mode == "human":
             return None
-        if self._top_view is None:
-            self._top_view = TopView(self.client, self.scene, self._light())
         robot = self.robot
+        if self._top_view is None:
+            # the background is rendered once: without the robot, or its body would
+            # stay painted where it stood at the first render
+            robot.set_visible(False)
+            try:
+                self._top_view = TopView(self.client, self.scene, self._light())
+            finally:
+                robot.set_visible(True)
         (ex, ey, _), cam_yaw, _ = robot.eye()
         x, y, yaw = robot.pose
         top = self._top_view.draw(x, y, yaw, cam_yaw, self.camera.hfov_deg)
