@@ -25,6 +25,7 @@ from vc_gym.compass import CompassAtlas, CompassConfig
 from vc_gym.envs.learning import LearningConfig, LearningResult, SpotLearning
 from vc_gym.errors import MapFileError
 from vc_gym.experiments.runner import ExperimentRun, Job
+from vc_gym.persistence import write_atomic
 
 __all__ = ["SavedAtlas", "atlas_key", "atlas_spec", "ensure_atlases", "learn_atlas_job"]
 
@@ -185,9 +186,7 @@ def ensure_atlases(
         if source is not None:
             src = Path(source) / f"{key}.npz"
             if src.is_file() and _matches(src, spec):
-                tmp = path.with_name(f".{path.name}.tmp")
-                shutil.copyfile(src, tmp)
-                os.replace(tmp, path)
+                write_atomic(path, lambda tmp, src=src: shutil.copyfile(src, tmp))
                 continue
         run.job_file("learn", key).unlink(missing_ok=True)  # its atlas is gone: learn again
         kwargs = {"spec": dict(spec), "path": str(path)}

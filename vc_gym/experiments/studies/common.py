@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from vc_gym.experiments.runner import ExperimentRun, LocalBackend, RayBackend, make_backend
 
-__all__ = ["SIZES", "ExperimentOptions", "open_run", "pick_size"]
+__all__ = ["SIZES", "ExperimentOptions", "median_timings", "open_run", "pick_size"]
 
 #: ``quick``: the size the tests use (seconds to a minute); ``paper``: the size of the
 #: ``paper`` report (all experiments in < 20 min on 2 cores); ``full``: the default.
@@ -86,3 +88,12 @@ def scene_field_bounds(scene: str) -> tuple[float, float, float, float]:
         return tuple(float(v) for v in room.scene.field_bounds)  # type: ignore[return-value]
     finally:
         room.close()
+
+
+def median_timings(timings: Iterable[Mapping[str, float]]) -> dict[str, float]:
+    """Per name, the median over jobs of their ``timing`` entries (ms), rounded."""
+    per: dict[str, list[float]] = {}
+    for timing in timings:
+        for name, ms in timing.items():
+            per.setdefault(name, []).append(ms)
+    return {n: round(float(np.median(v)), 3) for n, v in per.items()}

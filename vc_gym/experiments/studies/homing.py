@@ -36,7 +36,14 @@ from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot
 from vc_gym.localization import make_tracker
 from vc_gym.validation import positive_float
 
-__all__ = ["PAPER_MEAN_CM", "PAPER_STD_CM", "run_homing", "episode_job", "summarise_stops"]
+__all__ = [
+    "PAPER_MEAN_CM",
+    "PAPER_STD_CM",
+    "episode_job",
+    "run_homing",
+    "spread_over_seeds",
+    "summarise_stops",
+]
 
 PAPER_MEAN_CM = (-22.0, 12.0)
 PAPER_STD_CM = (17.0, 15.0)
@@ -76,7 +83,7 @@ SIZES = {
 
 def check_tracker_spec(tracker: Any) -> Any:
     """A tracker that can travel to a worker: a name, ``"module:factory"`` or a dict."""
-    if not isinstance(tracker, str | Mapping):
+    if not (isinstance(tracker, str) or (isinstance(tracker, Mapping) and "type" in tracker)):
         raise ValueError(
             "an experiment's tracker must be a name, 'package.module:factory' or a "
             f'{{"type": ...}} dict (the jobs run in other processes), got {tracker!r}'
@@ -186,6 +193,16 @@ def summarise_stops(episodes: Sequence[Mapping[str, Any]], success_radius_m: flo
 def _mean_std(values: Sequence[float]) -> list[float]:
     v = np.asarray(values, np.float64)
     return [round(float(v.mean()), 4), round(float(v.std(ddof=1)) if v.size > 1 else 0.0, 4)]
+
+
+def spread_over_seeds(per_seed: Sequence[Mapping[str, Any]]) -> dict[str, list[float]]:
+    """``[mean, std]`` over learning seeds of :func:`summarise_stops`' success and distance."""
+    return {
+        "success_rate_over_seeds": _mean_std([p["success_rate"] for p in per_seed]),
+        "mean_stop_distance_cm_over_seeds": _mean_std(
+            [p["mean_stop_distance_cm"] for p in per_seed]
+        ),
+    }
 
 
 def run_homing(
@@ -333,10 +350,7 @@ def run_homing(
     if done:
         overall = summarise_stops(done, success_radius_m)
         if len(per_seed) > 1:
-            overall["success_rate_over_seeds"] = _mean_std([p["success_rate"] for p in per_seed])
-            overall["mean_stop_distance_cm_over_seeds"] = _mean_std(
-                [p["mean_stop_distance_cm"] for p in per_seed]
-            )
+            overall.update(spread_over_seeds(per_seed))
         results["overall"] = overall
         _plot_stops(run.out / "stop_positions.png", done, settings, overall)
     if field and relearn == "scene":

@@ -29,10 +29,12 @@ from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.runner import ExperimentRun, Job, worker_cache
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
+    median_timings,
     open_run,
     pick_size,
     scene_field_bounds,
 )
+from vc_gym.experiments.studies.homing import check_tracker_spec
 from vc_gym.experiments.views import (
     COMPASS,
     PAPER_ERROR_DEG,
@@ -45,7 +47,6 @@ from vc_gym.experiments.views import (
     plot_error_vs_distance,
     view_poses,
 )
-from vc_gym.localization import make_tracker
 
 __all__ = [
     "DEFAULT_TRACKERS",
@@ -79,19 +80,16 @@ def rear_half_centre(bounds: Sequence[float]) -> tuple[float, float]:
 def check_trackers(trackers: Sequence[Any] | Mapping[str, Any]) -> dict[str, Any]:
     """``{name: spec}`` of trackers that can travel to workers (names must be unique)."""
     if isinstance(trackers, Mapping):
-        named = dict(trackers)
+        named = {str(name): check_tracker_spec(spec) for name, spec in trackers.items()}
     else:
         named = {}
         for spec in trackers:
-            if isinstance(spec, str):
-                name = spec
-            elif isinstance(spec, Mapping) and "type" in spec:
-                name = json.dumps(dict(spec), sort_keys=True, separators=(",", ":"))
-            else:
-                raise ValueError(
-                    "a tracker of an experiment must be a name, 'package.module:factory' or "
-                    f'a {{"type": ...}} dict (the jobs run in other processes), got {spec!r}'
-                )
+            spec = check_tracker_spec(spec)
+            name = (
+                spec
+                if isinstance(spec, str)
+                else json.dumps(spec, sort_keys=True, separators=(",", ":"))
+            )
             if name in named:
                 raise ValueError(f"tracker {name!r} given twice")
             named[name] = spec
@@ -99,9 +97,7 @@ def check_trackers(trackers: Sequence[Any] | Mapping[str, Any]) -> dict[str, Any
         raise ValueError("no trackers given")
     if COMPASS in named:
         raise ValueError(f"{COMPASS!r} is always reported (the single-frame compass)")
-    for spec in named.values():
-        make_tracker(spec)  # an unknown tracker fails here, not in a worker
-    return json.loads(json.dumps(named))
+    return named
 
 
 def view_job(
@@ -417,14 +413,10 @@ def _check_scenes(scenes: Sequence[str]) -> list[str]:
 
 def _cost_info(run: ExperimentRun) -> dict[str, Any]:
     """Median ms per update of every tracker over all view jobs (for ``run.json``)."""
-    costs: dict[str, list[float]] = {}
-    for stage, jobs in run.timings.items():
-        if not stage.startswith("views"):
-            continue
-        for timing in jobs.values():
-            for name, ms in timing.items():
-                costs.setdefault(name, []).append(ms)
-    return {"ms_per_update_median": {n: round(float(np.median(v)), 3) for n, v in costs.items()}}
+    views = [
+        t for stage, jobs in run.timings.items() if stage.startswith("views") for t in jobs.values()
+    ]
+    return {"ms_per_update_median": median_timings(views)}
 
 
 def summary_lines(results: Mapping[str, Any]) -> list[str]:

@@ -106,9 +106,7 @@ def _share(src: Path, pool: Path) -> None:
     for f in src.glob("*.npz"):
         dst = pool / f.name
         if not dst.exists():
-            tmp = pool / f".{f.name}.tmp"
-            shutil.copyfile(f, tmp)
-            os.replace(tmp, dst)
+            write_atomic(dst, lambda tmp, f=f: shutil.copyfile(f, tmp))
 
 
 def _tracker(res: Mapping[str, Any], scene: str, name: str) -> Mapping[str, Any]:

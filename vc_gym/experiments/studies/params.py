@@ -25,6 +25,7 @@ from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
+    median_timings,
     open_run,
     pick_size,
     scene_field_bounds,
@@ -154,15 +155,9 @@ def run_params(
 
 def _costs(run, labels: Sequence[str]) -> dict[str, dict[str, float]]:
     """Median ms per frame (learn, compass, grid) per configuration, from the jobs."""
-    out = {}
-    for label in labels:
-        timings = run.timings.get(f"views-{label}", {}).values()
-        per: dict[str, list[float]] = {}
-        for t in timings:
-            for name, ms in t.items():
-                per.setdefault(name, []).append(ms)
-        out[label] = {n: round(float(np.median(v)), 3) for n, v in per.items()}
-    return out
+    return {
+        label: median_timings(run.timings.get(f"views-{label}", {}).values()) for label in labels
+    }
 
 
 def _plot(path: Path, studies: Mapping[str, Any], costs: Mapping[str, Any]) -> None:

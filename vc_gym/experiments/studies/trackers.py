@@ -21,8 +21,13 @@ import numpy as np
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.runner import ExperimentRun, Job
-from vc_gym.experiments.studies.common import ExperimentOptions, open_run, pick_size
-from vc_gym.experiments.studies.homing import summarise_stops
+from vc_gym.experiments.studies.common import (
+    ExperimentOptions,
+    median_timings,
+    open_run,
+    pick_size,
+)
+from vc_gym.experiments.studies.homing import spread_over_seeds, summarise_stops
 from vc_gym.experiments.studies.orientation import (
     DEFAULT_TRACKERS,
     check_trackers,
@@ -125,12 +130,7 @@ def run_trackers(
                 for s in seeds
                 if any(e["learning_seed"] == s for e in eps)
             ]
-            row["homing"]["success_rate_over_seeds"] = _mean_std(
-                [b["success_rate"] for b in by_seed]
-            )
-            row["homing"]["mean_stop_distance_cm_over_seeds"] = _mean_std(
-                [b["mean_stop_distance_cm"] for b in by_seed]
-            )
+            row["homing"].update(spread_over_seeds(by_seed))
             row["homing"]["per_scene"] = {
                 sc: summarise_stops(per, 0.3) for sc, per in homing[name].items() if per
             }
@@ -205,25 +205,19 @@ def _safe(name: str) -> str:
     return keep[:40] or "tracker"
 
 
-def _mean_std(values: Sequence[float]) -> list[float]:
-    v = np.asarray(values, np.float64)
-    return [round(float(v.mean()), 4), round(float(v.std(ddof=1)) if v.size > 1 else 0.0, 4)]
-
-
 def _costs(run: ExperimentRun) -> dict[str, float]:
     """Median ms per update of each tracker: homing episodes and grid views together."""
-    per: dict[str, list[float]] = {}
+    timings: list[dict[str, float]] = []
     for stage, jobs in run.timings.items():
         for key, t in jobs.items():
             if stage == "episodes":
                 ms = t.get("tracker_ms_per_update")
                 name = run_job_tracker(run, key)
                 if ms is not None and name is not None:
-                    per.setdefault(name, []).append(ms)
+                    timings.append({name: ms})
             elif stage.startswith("views"):
-                for name, ms in t.items():
-                    per.setdefault(name, []).append(ms)
-    return {n: round(float(np.median(v)), 3) for n, v in per.items()}
+                timings.append(t)
+    return median_timings(timings)
 
 
 def run_job_tracker(run: ExperimentRun, key: str) -> str | None:
