@@ -61,6 +61,22 @@ def test_eq30_picks_the_best_spot_when_sharp():
     )
 
 
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: locate_eq30(np.zeros(3), SPOTS, 30.0),  # one score per spot
+        lambda: locate_eq30(np.full(len(SPOTS), np.nan), SPOTS, 30.0),
+        lambda: locate_eq30(np.zeros(len(SPOTS)), SPOTS, 0.0),
+        lambda: calibrate(SPOTS, SPOTS, np.zeros((len(SPOTS), 2))),
+        lambda: calibrate(SPOTS[:, :1], SPOTS, np.zeros((len(SPOTS), len(SPOTS)))),
+        lambda: locate_calibrated(np.zeros(2), SPOTS, None, BOUNDS),
+    ],
+)
+def test_bad_inputs_are_clear_errors(call):
+    with pytest.raises(ValueError, match="shape|finite|sharpness"):
+        call()
+
+
 def test_the_experiment_end_to_end(tmp_path, capsys):
     assert main(["experiment", "localization", "--quick", "--out", str(tmp_path)]) == 0
     r = json.loads((tmp_path / "results.json").read_text())

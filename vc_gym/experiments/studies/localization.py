@@ -159,6 +159,18 @@ def locate_job(
     return {"views": out}
 
 
+def _array(name: str, value: object, shape: tuple[int | None, ...]) -> np.ndarray:
+    """``value`` as a finite float array of ``shape`` (None: any length), or a ValueError."""
+    a = np.asarray(value, dtype=np.float64)
+    if a.ndim != len(shape) or any(
+        w is not None and n != w for n, w in zip(a.shape, shape, strict=False)
+    ):
+        raise ValueError(f"{name} must have shape {shape} (None: any), got {a.shape}")
+    if a.size == 0 or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be non-empty and finite")
+    return a
+
+
 #: Length scales tried for the saturating fall of goodness with distance (metres).
 LENGTH_SCALES_M = (0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0)
 
@@ -180,7 +192,10 @@ def calibrate(
 
     Returns ``(a, b, sigma, λ)``.
     """
+    spots = _array("spots", spots, (None, 2))
+    positions = _array("positions", positions, (None, 2))
     n = spots.shape[0]
+    scores = _array("scores", scores, (positions.shape[0], n))
     best = None
     for length in LENGTH_SCALES_M:
         a, b, sigma = np.zeros(n), np.zeros(n), np.zeros(n)
@@ -201,6 +216,8 @@ def locate_calibrated(
     scores: np.ndarray, spots: np.ndarray, model: tuple, bounds: Sequence[float]
 ) -> tuple[np.ndarray, np.ndarray]:
     """Posterior mean and per-axis std of the position given each spot's raw score."""
+    spots = _array("spots", spots, (None, 2))
+    scores = _array("scores", scores, (spots.shape[0],))
     a, b, sigma, length = model
     x0, x1, y0, y1 = bounds
     gx = np.arange(x0, x1 + 1e-9, GRID_STEP_M)
@@ -219,6 +236,10 @@ def locate_calibrated(
 
 def locate_eq30(scores: np.ndarray, spots: np.ndarray, sharpness: float) -> np.ndarray:
     """Eq. 30 over every spot: weights ``∝ exp(sharpness · score)``."""
+    spots = _array("spots", spots, (None, 2))
+    scores = _array("scores", scores, (spots.shape[0],))
+    if not (np.isfinite(sharpness) and sharpness > 0):
+        raise ValueError(f"sharpness must be finite and > 0, got {sharpness}")
     logw = sharpness * (scores - scores.max())
     w = np.exp(logw)
     return (w / w.sum()) @ spots
