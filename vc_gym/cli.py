@@ -390,7 +390,8 @@ def build_parser() -> argparse.ArgumentParser:
         choices=["improved", "paper"],
         default="improved",
         help="improved (default): normalise the spots with the first turn's frames at the "
-        "true home; paper: after walking back home by odometry (the paper's procedure)",
+        "true home, and check home with a full turn before stopping; paper: normalise "
+        "after walking back home by odometry and stop where the estimate says home",
     )
     _add_tracker_option(p)
     p.set_defaults(func=_cmd_demo)
@@ -478,7 +479,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--mode",
         choices=["paper", "improved"],
         default="paper",
-        help="how the place is learned: paper (default) or improved (as the demo)",
+        help="how the place is learned and the scripted agent homes: paper (default) or "
+        "improved (as the demo: normalised at the true home, home checked with a full turn)",
     )
     _add_tracker_option(p)
     p.add_argument(
@@ -636,8 +638,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--mode",
         choices=["paper", "improved"],
-        help="homing: paper (the paper's learning phase, default) or improved (the spots "
-        "normalised with the frames of the first turn at the true home)",
+        help="homing: paper (the paper's procedure, default) or improved (the spots "
+        "normalised with the frames of the first turn at the true home; the scripted agent "
+        "checks home with a full turn before it stops)",
     )
     p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")

@@ -75,3 +75,93 @@ def test_bad_parameters(kwargs):
         ScriptedHomingPolicy(velocity, **kwargs)
     with pytest.raises(ValueError):
         ScriptedHomingPolicy("fast")
+
+
+class AliasingWorld:
+    """A kinematic robot whose tracker aliases: facing within ±30° of east it reports
+    "home" wherever it is; at other headings it reports 0.6 × the true position. Over a
+    full turn that averages to half the true position (the full-turn average of the
+    atlas' eq. 30 shrinks like that 1-2 m from home)."""
+
+    def __init__(self, x, y, heading_deg):
+        self.x, self.y, self.h = x, y, heading_deg
+
+    def obs(self, odometry=(0.0, 0.0, 0.0)):
+        alias = abs((self.h + 180.0) % 360.0 - 180.0) <= 30.0
+        px, py = (0.0, 0.0) if alias else (0.6 * self.x, 0.6 * self.y)
+        th = np.radians(self.h)
+        dx, dy = -px, -py  # home at the origin
+        fwd, left = dx * np.cos(th) + dy * np.sin(th), -dx * np.sin(th) + dy * np.cos(th)
+        return {
+            "home_vector": np.array([fwd, left]),
+            "heading_spread": np.array([2.0]),
+            "heading": np.array([np.cos(th), np.sin(th)]),
+            "odometry": np.array(odometry, np.float64),
+        }
+
+    def step(self, action, dt=0.1):
+        fwd, turn = float(action[0]) * dt, float(action[2]) * dt
+        th = np.radians(self.h)
+        self.x += fwd * np.cos(th)
+        self.y += fwd * np.sin(th)
+        self.h = (self.h + turn) % 360.0
+        return self.obs((fwd, 0.0, turn))
+
+
+def run_until_still(p, world, steps=1200):
+    o = world.obs()
+    still = 0
+    for _ in range(steps):
+        a = p.predict(o)
+        still = still + 1 if ScriptedHomingPolicy.is_still(a) else 0
+        if still >= 50:  # the task's 5 s stop rule
+            return True
+        o = world.step(a)
+    return False
+
+
+def test_paper_policy_stops_where_one_view_aliases_with_home():
+    world = AliasingWorld(-1.2, 0.6, 0.0)
+    assert run_until_still(policy(settle_time_s=0.0), world)
+    assert np.hypot(world.x, world.y) > 1.3  # never moved
+
+
+def test_verify_home_turns_and_walks_out_of_an_alias():
+    p = policy(settle_time_s=0.0, verify_home=True, verify_gain=2.0, max_verifications=6)
+    world = AliasingWorld(-1.2, 0.6, 0.0)
+    assert run_until_still(p, world)
+    assert p.phase == "done"
+    assert np.hypot(world.x, world.y) < 0.15  # home
+    first = p.checks[0]  # the first full turn points home: half of (+1.2, -0.6)
+    assert first == pytest.approx((0.6, -0.3), abs=0.05)
+    assert np.hypot(*p.checks[-1]) <= p.verify_tolerance_m
+
+
+def test_verify_home_stops_after_max_verifications():
+    p = policy(settle_time_s=0.0, verify_home=True, verify_gain=0.2, max_verifications=2)
+    world = AliasingWorld(-1.2, 0.6, 0.0)
+    assert run_until_still(p, world)
+    assert len(p.checks) == 2 and p.phase == "done"
+
+
+def test_verify_home_at_home_stops_after_one_turn():
+    p = policy(settle_time_s=0.0, verify_home=True)
+    world = AliasingWorld(0.02, -0.03, 90.0)
+    assert run_until_still(p, world)
+    assert len(p.checks) == 1 and np.hypot(world.x, world.y) < 0.05
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"verify_home": "yes"},
+        {"verify_tolerance_m": 0.0},
+        {"verify_gain": float("inf")},
+        {"max_verifications": 0},
+        {"max_verifications": 2.5},
+        {"verify_turn_deg_s": -10.0},
+    ],
+)
+def test_bad_verification_parameters(kwargs):
+    with pytest.raises(ValueError):
+        ScriptedHomingPolicy(velocity, **kwargs)

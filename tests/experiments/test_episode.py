@@ -52,3 +52,21 @@ def test_record_holds_what_the_plots_need(tracker):
     s = record.summary()
     assert s["decisions"] == n and s["home_error_m"] == record.stop_error_m
     assert "tracker_time_s" not in s  # figures only, no timings
+
+
+def test_modes_choose_the_learning_and_the_policy():
+    from vc_gym.experiments.episode import HOMING_MODES, homing_mode
+
+    assert homing_mode("paper").policy == {} and homing_mode("paper").learning == {}
+    assert homing_mode("improved").policy == {"verify_home": True}
+    assert homing_mode("improved").learning == {"normalise_at": "start"}
+    assert set(HOMING_MODES) == {"paper", "improved"}
+    with pytest.raises(ValueError, match="paper"):
+        homing_mode("best")
+    run = make_homing_run(mode="improved", policy={"max_verifications": 2}, **SHORT)
+    try:
+        policy = run.act.__self__
+        assert policy.verify_home and policy.max_verifications == 2
+        assert run.env.unwrapped.learn_config.normalise_at == "start"
+    finally:
+        run.close()

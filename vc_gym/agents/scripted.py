@@ -14,6 +14,7 @@ from collections.abc import Callable
 import numpy as np
 
 from vc_gym.envs.learning import HEAD_SCAN_DEG
+from vc_gym.poses import body_to_world, world_to_body
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["ScriptedHomingPolicy"]
@@ -47,6 +48,27 @@ class ScriptedHomingPolicy:
         Once within ``home_tolerance_m``, walk again only when the estimate leaves
         ``rearm_factor × home_tolerance_m`` (the estimate jitters by ~0.1 m as the head
         scans; without this hysteresis the robot shuffles around home and never stops).
+    verify_home : bool
+        Beyond the paper: before stopping, check that this is home. The eq. 30
+        position of a single view can alias: from some spots 1–2 m away, one heading
+        looks exactly like home (every spot's goodness ≈ 1), and the paper's robot
+        stops there. A place aliases at some headings, not at all of them, so when the
+        estimate says "home" the robot turns a full circle on the spot (head
+        straight) and averages the home offset ``R(θ̂)·home_vector`` over the turn. If
+        that average is within ``verify_tolerance_m`` it stops; otherwise it walks
+        ``verify_gain`` times the averaged offset by dead reckoning (odometry only,
+        since the view it would correct with is the one that aliases) and checks again,
+        at most ``max_verifications`` times. The full-turn average points towards home
+        everywhere on the robolab field but shrinks with distance (about half the
+        distance at 1–2 m), hence the gain above 1.
+    verify_tolerance_m : float
+        The full-turn home offset that counts as home.
+    verify_gain : float
+        Multiplier of the averaged offset walked after a failed check.
+    max_verifications : int
+        Full turns at most per episode; after the last one the robot stops.
+    verify_turn_deg_s : float
+        Turn rate of the checking turn.
     """
 
     def __init__(
@@ -58,6 +80,11 @@ class ScriptedHomingPolicy:
         settle_time_s: float = 2.0,
         max_spread_deg: float = 30.0,
         rearm_factor: float = 2.5,
+        verify_home: bool = False,
+        verify_tolerance_m: float = 0.15,
+        verify_gain: float = 1.5,
+        max_verifications: int = 4,
+        verify_turn_deg_s: float = 60.0,
     ):
         if not callable(velocity_action):
             raise ValueError(f"velocity_action must be callable, got {velocity_action!r}")
@@ -66,6 +93,9 @@ class ScriptedHomingPolicy:
             ("home_tolerance_m", home_tolerance_m),
             ("max_spread_deg", max_spread_deg),
             ("rearm_factor", rearm_factor),
+            ("verify_tolerance_m", verify_tolerance_m),
+            ("verify_gain", verify_gain),
+            ("verify_turn_deg_s", verify_turn_deg_s),
         ):
             positive_float(name, v)
         nonnegative_float("settle_time_s", settle_time_s)
@@ -82,6 +112,17 @@ class ScriptedHomingPolicy:
         self.rearm_factor = float(rearm_factor)
         if self.rearm_factor < 1:
             raise ValueError(f"rearm_factor must be >= 1, got {rearm_factor!r}")
+        if not isinstance(verify_home, bool):
+            raise ValueError(f"verify_home must be a bool, got {verify_home!r}")
+        if isinstance(max_verifications, bool) or not isinstance(max_verifications, int) or (
+            max_verifications < 1
+        ):
+            raise ValueError(f"max_verifications must be an int >= 1, got {max_verifications!r}")
+        self.verify_home = verify_home
+        self.verify_tolerance_m = float(verify_tolerance_m)
+        self.verify_gain = float(verify_gain)
+        self.max_verifications = max_verifications
+        self.verify_turn_deg_s = float(verify_turn_deg_s)
         self.reset()
 
     @classmethod
@@ -100,9 +141,19 @@ class ScriptedHomingPolicy:
         self._t = 0
         self._scan_i = 0
         self._arrived = False
+        #: "walk" (the paper's behaviour), "verify" (checking turn), "correct" (dead
+        #: reckoning to the checked offset) or "done"
+        self.phase = "walk"
+        #: world-frame home offset (m) averaged over each checking turn, in order
+        self.checks: list[tuple[float, float]] = []
+        self._turned_deg = 0.0
+        self._offsets: list[tuple[float, float]] = []
+        self._target = (0.0, 0.0)
 
     def predict(self, obs: dict[str, np.ndarray]) -> np.ndarray:
         """The action (``Box(-1, 1, (5,))`` of the env) for one observation."""
+        if self.verify_home and self.phase != "walk":
+            return self._verifying(obs)
         fwd_home, left_home = (float(v) for v in obs["home_vector"])
         spread = float(obs["heading_spread"][0])
         settling = self._t * self.dt_s < self.settle_time_s or spread > self.max_spread_deg
@@ -111,17 +162,62 @@ class ScriptedHomingPolicy:
         # hysteresis: once arrived, only a clearly wrong estimate makes the robot move
         tol = self.home_tolerance_m
         self._arrived = dist <= (self.rearm_factor if self._arrived else 1.0) * tol
+        if self.verify_home and not settling and self._arrived:
+            return self._start_verification()
         forward, turn = 0.0, 0.0
         if not settling and not self._arrived:
-            err = math.degrees(math.atan2(left_home, fwd_home))
-            turn = float(np.clip(2.5 * err, -60.0, 60.0))
-            forward = 0.0 if abs(err) > 30 else min(0.25, 0.8 * dist)
+            forward, turn = self._walk_towards(fwd_home, left_home)
         pan = 0.0
         if forward == 0.0:
             pans = self.head_scan_deg
             self._scan_i = (self._scan_i + 1) % len(pans)
             pan = pans[self._scan_i]
         return self.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
+
+    def _walk_towards(self, fwd: float, left: float) -> tuple[float, float]:
+        """Forward speed and turn rate towards a robot-frame point (the paper's gait)."""
+        err = math.degrees(math.atan2(left, fwd))
+        turn = float(np.clip(2.5 * err, -60.0, 60.0))
+        forward = 0.0 if abs(err) > 30 else min(0.25, 0.8 * math.hypot(fwd, left))
+        return forward, turn
+
+    def _start_verification(self) -> np.ndarray:
+        if len(self.checks) >= self.max_verifications:
+            self.phase = "done"
+        else:
+            self.phase, self._turned_deg, self._offsets = "verify", 0.0, []
+        return self._verifying(None)
+
+    def _verifying(self, obs: dict[str, np.ndarray] | None) -> np.ndarray:
+        if self.phase == "verify":
+            if obs is not None:
+                self._turned_deg += abs(float(obs["odometry"][2]))
+                c, s = (float(v) for v in obs["heading"])
+                heading = math.degrees(math.atan2(s, c))
+                self._offsets.append(body_to_world(*map(float, obs["home_vector"]), heading))
+            if self._turned_deg < 360.0:
+                return self.velocity_action(turn_deg_s=self.verify_turn_deg_s, pan_deg=0.0)
+            dx, dy = (float(v) for v in np.mean(self._offsets, axis=0))
+            self.checks.append((dx, dy))
+            if math.hypot(dx, dy) <= self.verify_tolerance_m:
+                self.phase = "done"
+            else:
+                c, s = (float(v) for v in obs["heading"])
+                heading = math.degrees(math.atan2(s, c))
+                g = self.verify_gain
+                self._target = world_to_body(g * dx, g * dy, heading)
+                self.phase = "correct"
+                return self._verifying(None)
+        if self.phase == "correct":
+            if obs is not None:
+                fwd, left, turn = (float(v) for v in obs["odometry"])
+                tf, tl = self._target
+                self._target = world_to_body(tf - fwd, tl - left, turn)
+            if math.hypot(*self._target) <= 0.5 * self.home_tolerance_m:
+                return self._start_verification()
+            forward, turn = self._walk_towards(*self._target)
+            return self.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=0.0)
+        return self.velocity_action(pan_deg=0.0)  # done: stand still until the task ends
 
     @staticmethod
     def is_still(action: np.ndarray, threshold: float = 0.05) -> bool:

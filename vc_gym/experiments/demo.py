@@ -58,9 +58,10 @@ def run_demo(
     progress : bool
         Progress bars per phase.
     mode : str
-        How the place is learned (:data:`~vc_gym.experiments.episode.HOMING_MODES`):
-        ``"improved"`` (default; over learning seeds 0-5 it homes better than the paper's
-        procedure, see README) or ``"paper"``.
+        How the place is learned and the robot homes
+        (:data:`~vc_gym.experiments.episode.HOMING_MODES`): ``"improved"`` (default; over
+        learning seeds 0-8 it homes better than the paper's procedure, see README) or
+        ``"paper"``.
 
     Returns
     -------

@@ -27,9 +27,11 @@ from vc_gym.localization import TrackerSpec
 __all__ = [
     "HOMING_MODES",
     "EpisodeRecord",
+    "HomingMode",
     "EpisodeStep",
     "HomingRun",
     "make_homing_run",
+    "homing_mode",
     "run_episode",
 ]
 
@@ -147,15 +149,40 @@ class HomingRun:
         self.env.close()
 
 
-#: How the place is learned, by name: task arguments of ``vc_gym/LearnThenHome-v0``.
-#: ``paper``: the paper's procedure (5.2), normalising the spots after walking back home
-#: by odometry, whose drift (15-20 cm in the simulated robolab) becomes the stops'
-#: systematic offset. ``improved``: normalising with every frame of the first turn,
-#: taken at the true home before the robot moved.
-HOMING_MODES: dict[str, dict[str, Any]] = {
-    "paper": {},
-    "improved": {"normalise_at": "start"},
+@dataclass(frozen=True)
+class HomingMode:
+    """How the place is learned and how the scripted agent homes, by name.
+
+    Attributes
+    ----------
+    learning : dict
+        Task arguments of ``vc_gym/LearnThenHome-v0`` that shape the learned atlas
+        (saved with it: ``normalise_at``).
+    policy : dict
+        Keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`.
+    """
+
+    learning: dict[str, Any]
+    policy: dict[str, Any]
+
+
+#: The homing modes. ``paper``: the paper's procedure (5.2), normalising the spots
+#: after walking back home by odometry, whose drift (15-20 cm in the simulated robolab)
+#: becomes the stops' systematic offset, and stopping wherever the estimate says home.
+#: ``improved``: normalising with every frame of the first turn, taken at the true home
+#: before the robot moved, and checking with a full turn that the place is home before
+#: stopping (``verify_home``; a single view can alias with home 1-2 m away).
+HOMING_MODES: dict[str, HomingMode] = {
+    "paper": HomingMode(learning={}, policy={}),
+    "improved": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
 }
+
+
+def homing_mode(mode: str) -> HomingMode:
+    """The :class:`HomingMode` called ``mode``, or a ``ValueError`` naming the modes."""
+    if not isinstance(mode, str) or mode not in HOMING_MODES:
+        raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
+    return HOMING_MODES[mode]
 
 
 def make_homing_run(
@@ -169,6 +196,7 @@ def make_homing_run(
     learner: Callable | None = None,
     keep_image: bool = False,
     mode: str = "paper",
+    policy: dict[str, Any] | None = None,
 ) -> HomingRun:
     """The homing task with the paper's 5 s stop rule, and an agent to run it.
 
@@ -192,10 +220,15 @@ def make_homing_run(
         keep: this argument does not change it (the video renders the frame from the
         env instead, see :class:`~vc_gym.experiments.video.EpisodeVideo`).
     mode : str
-        How the place is learned (:data:`HOMING_MODES`): ``"paper"`` or ``"improved"``.
+        How the place is learned and how the scripted agent homes
+        (:data:`HOMING_MODES`): ``"paper"`` or ``"improved"``. With a saved atlas
+        (``learner``) only the policy part applies; the atlas brings its own learning.
+    policy : dict, optional
+        More keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`,
+        over those of the mode (scripted agent only).
     """
-    if mode not in HOMING_MODES:
-        raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
+    chosen = homing_mode(mode)
+    policy_kwargs = {**chosen.policy, **(policy or {})}
     from vc_gym.agents.scripted import ScriptedHomingPolicy
     from vc_gym.envs.compass_observation import CompassObservation
 
@@ -206,15 +239,15 @@ def make_homing_run(
         "stop_time_s": 5.0,  # the paper's rule, also for agents trained with a shorter one
         "success_radius_m": success_radius_m,
         "max_homing_s": max_homing_s,
-        **HOMING_MODES[mode],
+        **chosen.learning,
     }
     if learner is not None:
         task["learner"] = learner
     if agent == "scripted":
         env = gym.make("vc_gym/LearnThenHome-v0", **task)
         env = CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
-        policy = ScriptedHomingPolicy.for_env(env)
-        return HomingRun(env, policy.predict, policy.reset)
+        scripted = ScriptedHomingPolicy.for_env(env, **policy_kwargs)
+        return HomingRun(env, scripted.predict, scripted.reset)
     from vc_gym.agents.learned import LearnedHomingAgent
 
     learned = LearnedHomingAgent(agent)

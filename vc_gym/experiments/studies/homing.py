@@ -23,7 +23,7 @@ import numpy as np
 
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.episode import HOMING_MODES, make_homing_run, run_episode
+from vc_gym.experiments.episode import HOMING_MODES, homing_mode, make_homing_run, run_episode
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.runner import Job, worker_cache
 from vc_gym.experiments.studies.common import (
@@ -47,7 +47,8 @@ __all__ = [
 
 PAPER_MEAN_CM = (-22.0, 12.0)
 PAPER_STD_CM = (17.0, 15.0)
-#: How the place is learned, by name (see :data:`~vc_gym.experiments.episode.HOMING_MODES`).
+#: How the place is learned and the scripted agent homes, by name (see
+#: :data:`~vc_gym.experiments.episode.HOMING_MODES`).
 MODES = HOMING_MODES
 #: A stop this far from home is a "far stop": the robot trusted a position it had no
 #: evidence for (or never found home).
@@ -104,6 +105,7 @@ def _run_for(kwargs: Mapping[str, Any]):
         max_homing_s=kwargs["max_homing_s"],
         learner=SavedAtlas(atlas) if atlas else None,
         keep_image=kwargs.get("video") is not None,
+        mode=kwargs.get("mode", "paper"),
     )
     if atlas:
         run.env.reset(seed=kwargs["learning_seed"])  # loads the saved atlas
@@ -121,11 +123,13 @@ def episode_job(
     learning_seed: int,
     episode_seed: int,
     video: str | None = None,
+    mode: str = "paper",
 ) -> dict[str, Any]:
     """Job: one kidnapping (seed ``episode_seed``) with the saved ``atlas``.
 
     ``atlas=None`` learns anew in the episode (``relearn="episode"``). With ``video``
-    the episode is also written there as MP4. Returns the episode's figures.
+    the episode is also written there as MP4. ``mode`` is the homing mode (its policy;
+    a saved atlas brings its own learning). Returns the episode's figures.
     """
     kwargs = dict(locals())
     cache_key = json.dumps(
@@ -249,7 +253,8 @@ def run_homing(
     field : bool
         Also measure the likelihood field of fig. 5 (right).
     mode : str
-        ``"paper"`` or ``"improved"`` (:data:`MODES`: how the place is learned).
+        ``"paper"`` or ``"improved"`` (:data:`MODES`: how the place is learned and how
+        the scripted agent homes).
 
     Returns
     -------
@@ -274,10 +279,7 @@ def run_homing(
         positive_float(name, v)
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
-    if mode not in MODES:
-        raise ValueError(f"mode must be one of {list(MODES)}, got {mode!r}")
-    if mode != "paper" and relearn != "scene":
-        raise ValueError("mode applies to the saved atlases: use relearn='scene'")
+    homing_mode(mode)
     tracker = check_tracker_spec(tracker)
     if agent == "pretrained":
         from vc_gym.agents.learned import PRETRAINED_MODEL
@@ -307,7 +309,10 @@ def run_homing(
         **({"mode": mode} if mode != "paper" else {}),
     }
     run = open_run(out_dir, "homing", opts, settings)
-    specs = {s: atlas_spec(scene, s, "scripted", learn_time_s, learning=MODES[mode]) for s in seeds}
+    specs = {
+        s: atlas_spec(scene, s, "scripted", learn_time_s, learning=MODES[mode].learning)
+        for s in seeds
+    }
     atlases = (
         ensure_atlases(run, list(specs.values()), opts.atlas_dir) if relearn == "scene" else {}
     )
@@ -326,6 +331,7 @@ def run_homing(
                 "atlas": atlases.get(atlas_key(specs[s])),
                 "learning_seed": s,
                 "episode_seed": s + 1 + i,
+                **({"mode": mode} if mode != "paper" else {}),
             }
             if n < opts.video:
                 kwargs["video"] = str((videos / f"seed{s}-episode{i:03d}.mp4").resolve())
