@@ -19,6 +19,7 @@ from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["ScriptedHomingPolicy"]
 
+
 class ScriptedHomingPolicy:
     """The paper's homing behaviour on :class:`~vc_gym.envs.CompassObservation` outputs.
 
@@ -114,8 +115,10 @@ class ScriptedHomingPolicy:
             raise ValueError(f"rearm_factor must be >= 1, got {rearm_factor!r}")
         if not isinstance(verify_home, bool):
             raise ValueError(f"verify_home must be a bool, got {verify_home!r}")
-        if isinstance(max_verifications, bool) or not isinstance(max_verifications, int) or (
-            max_verifications < 1
+        if (
+            isinstance(max_verifications, bool)
+            or not isinstance(max_verifications, int)
+            or (max_verifications < 1)
         ):
             raise ValueError(f"max_verifications must be an int >= 1, got {max_verifications!r}")
         self.verify_home = verify_home
