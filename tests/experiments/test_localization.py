@@ -10,10 +10,12 @@ import pytest
 
 from vc_gym.cli import main
 from vc_gym.experiments.studies.localization import (
+    BORDER_MARGIN_M,
     calibrate,
     calibration_points,
     locate_calibrated,
     locate_eq30,
+    locate_nearest,
 )
 
 SPOTS = np.array([[x, y] for x in (-2.25, -0.75, 0.75, 2.25) for y in (-1.5, 0.0, 1.5)])
@@ -52,6 +54,41 @@ def test_calibration_points_are_the_spots_and_the_midpoints_between_neighbours()
     assert not any(np.allclose(p, (-1.5, -0.75)) for p in pts)  # no diagonals
 
 
+def test_border_points_cover_the_strip_beyond_the_outer_spots():
+    pts = calibration_points(SPOTS, BOUNDS)
+    inner = calibration_points(SPOTS)
+    border = pts[len(inner) :]
+    assert len(border) == 3 * 2 + 4 * 2 + 4  # rows' ends, columns' ends, corners
+    edge = 3.0 - BORDER_MARGIN_M
+    assert any(np.allclose(p, (-edge, 0.0)) for p in border)
+    assert any(np.allclose(p, (0.75, 2.0 - BORDER_MARGIN_M)) for p in border)
+    assert any(np.allclose(p, (edge, -(2.0 - BORDER_MARGIN_M))) for p in border)
+    assert np.all(np.abs(border[:, 0]) <= edge + 1e-9)
+
+
+def test_nearest_signatures_interpolate_between_places():
+    rng = np.random.default_rng(1)
+    a = rng.uniform(-0.12, -0.06, len(SPOTS))
+    b = rng.uniform(0.15, 0.25, len(SPOTS))
+    places = calibration_points(SPOTS, BOUNDS)
+    sig = np.array([scores_at(p, a, b, 0.7) for p in places])
+    sigma = np.full(len(SPOTS), 0.02)
+    # at a calibration place: that place exactly, with the floor spread
+    mean, std = locate_nearest(sig[5], places, sig, sigma)
+    np.testing.assert_allclose(mean, places[5], atol=1e-6)
+    # between places: no farther than the places' spacing (0.75 m) allows, and the
+    # spread says it is between places
+    for true in ((-0.375, 0.0), (0.3, 0.4), (-2.6, 1.8), (1.9, -0.2)):
+        mean, std = locate_nearest(scores_at(true, a, b, 0.7), places, sig, sigma)
+        assert np.hypot(*(mean - true)) < 0.4 and np.max(std) > 0.1
+    with pytest.raises(ValueError, match="k must"):
+        locate_nearest(sig[0], places, sig, sigma, k=0)
+    with pytest.raises(ValueError, match="sigma"):
+        locate_nearest(sig[0], places, sig, -sigma)
+    with pytest.raises(ValueError, match="shape"):
+        locate_nearest(sig[0][:3], places, sig, sigma)
+
+
 def test_eq30_picks_the_best_spot_when_sharp():
     s = np.full(len(SPOTS), -0.3)
     s[4] = -0.1
@@ -80,11 +117,12 @@ def test_bad_inputs_are_clear_errors(call):
 def test_the_experiment_end_to_end(tmp_path, capsys):
     assert main(["experiment", "localization", "--quick", "--out", str(tmp_path)]) == 0
     r = json.loads((tmp_path / "results.json").read_text())
-    assert set(r["methods"]) == {"paper", "calibrated"}
+    assert set(r["methods"]) == {"paper", "calibrated", "turn_calibrated", "turn_nearest"}
     n = len(r["true_positions"])
-    for m in r["methods"].values():
+    for name, m in r["methods"].items():
         assert len(m["estimates"]) == n > 0 and m["mean_error_m"] >= 0
-    assert 0.0 <= r["methods"]["calibrated"]["within_2_sigma"] <= 1.0
+        if name != "paper":
+            assert 0.0 <= m["within_2_sigma"] <= 1.0
     assert (tmp_path / "localization.png").read_bytes()[:4] == b"\x89PNG"
     assert "calibrated" in capsys.readouterr().out
 

@@ -17,8 +17,24 @@ a finer grid of test poses. Two position estimates are compared on the same fram
     ``Π_i N(score_i; a_i − b_i·(1 − exp(−d_i(x)/λ)), σ_i)``, whose mean is the estimate
     and whose spread its uncertainty.
 
+The same two, and a third, are also computed from a **full turn** on the spot: the robot
+turns through ``turn_headings`` directions (the checking turn of the improved homing
+policy) and each spot's score is averaged over the turn. A single view's score depends
+on where the camera looks as much as on where the robot stands (frame-to-frame spread
+0.05–0.07 at one place); over a turn that spread falls to about 0.02, so the distance
+information carries. Calibration for the turn methods uses turns at the calibration
+points, which here also include points on the field's border beyond the outer spots
+(where a learning robot can walk too):
+
+``turn_calibrated``
+    The ``calibrated`` likelihood on turn-averaged scores and turn calibration.
+``turn_nearest``
+    Place recognition by the turn's score signature: the ``k`` calibration places whose
+    turn-averaged scores are nearest (each spot's score divided by its residual spread),
+    weighted by inverse signature distance; their weighted spread is the uncertainty.
+
 Results: mean, median and 90th-percentile position error over the field per method, the
-share of true positions inside the calibrated 2σ ellipse, and a PNG of both error fields.
+share of true positions inside each uncertain method's 2σ, and a PNG of the error fields.
 """
 
 from __future__ import annotations
@@ -45,7 +61,15 @@ from vc_gym.experiments.studies.common import (
 from vc_gym.experiments.studies.orientation import one_scene
 from vc_gym.experiments.views import field_grid, look, view_poses
 
-__all__ = ["calibrate", "locate_calibrated", "locate_eq30", "run_localization", "summary_lines"]
+__all__ = [
+    "calibrate",
+    "calibration_points",
+    "locate_calibrated",
+    "locate_eq30",
+    "locate_nearest",
+    "run_localization",
+    "summary_lines",
+]
 
 SIZES = {
     "quick": {
@@ -55,6 +79,8 @@ SIZES = {
         "headings": 1,
         "frames": 2,
         "calibration_headings": 2,
+        "turn_headings": 4,
+        "turn_frames": 1,
     },
     "paper": {
         "spot_spacing_m": 1.5,
@@ -63,6 +89,8 @@ SIZES = {
         "headings": 1,
         "frames": 4,
         "calibration_headings": 4,
+        "turn_headings": 8,
+        "turn_frames": 2,
     },
     "full": {
         "spot_spacing_m": 1.5,
@@ -71,12 +99,18 @@ SIZES = {
         "headings": 2,
         "frames": 6,
         "calibration_headings": 8,
+        "turn_headings": 8,
+        "turn_frames": 3,
     },
 }
 #: Margin of the spot grid inside the field (metres).
 SPOT_MARGIN_M = 0.5
 #: Resolution of the calibrated position likelihood (metres).
 GRID_STEP_M = 0.05
+#: Calibration places whose signatures make a ``turn_nearest`` estimate.
+NEAREST_K = 3
+#: Distance kept from the field's edges by border calibration points (metres).
+BORDER_MARGIN_M = 0.25
 
 
 def _room(scene: str) -> AiboRoomEnv:
@@ -90,13 +124,17 @@ def learn_grid_job(
     calibration_headings: int,
     seed: int,
     path: str,
+    turn_headings: int = 0,
+    turn_frames: int = 1,
 ) -> dict[str, Any]:
     """Job: learn a map at every spot (8 × 45°, head scanning) and the calibration frames.
 
     Colour classes are fitted once, on the first frame of every direction at the spot
     nearest the field centre, and shared by every map (the goodness of different spots
     is then comparable). Calibration frames (random headings, not learned) are taken at
-    every spot; their raw scores under every map are saved with the atlas.
+    every calibration point (:func:`calibration_points`, with the field's border); their
+    raw scores under every map are saved with the atlas, and with ``turn_headings`` also
+    the scores averaged over a turn at each point (:func:`turn_scores`).
     """
     room = _room(scene)
     room.reset(seed=seed)
@@ -116,21 +154,72 @@ def learn_grid_job(
         maps[f"spot{i}"] = ((float(x), float(y)), vc)
     atlas = CompassAtlas(maps, home=f"spot{centre}")
     rng = np.random.default_rng([seed, 77])
-    positions, scores = [], []
-    for i, (x, y) in enumerate(calibration_points(pts)):
+    positions, scores, turns = [], [], []
+    places = calibration_points(pts, room.scene.field_bounds)
+    for i, (x, y) in enumerate(places):
         for h in rng.uniform(0.0, 360.0, calibration_headings):
             for image, _, _ in look(room, (x, y, float(h)), 2, seed=seed + 50_000 + i):
                 raw, _ = atlas.scores(image, camera)
                 positions.append([float(x), float(y)])
                 scores.append([round(float(v), 6) for v in raw])
-    atlas.save(path, metadata={"calibration": {"positions": positions, "scores": scores}})
-    return {"spots": len(pts), "calibration_frames": len(scores)}
+        if turn_headings:
+            start = float(rng.uniform(0.0, 360.0 / turn_headings))
+            turn = turn_scores(
+                room,
+                atlas,
+                camera,
+                (x, y),
+                start,
+                turn_headings,
+                turn_frames,
+                seed=seed + 70_000 + 100 * i,
+            )
+            turns.append([round(float(v), 6) for v in turn])
+    calibration: dict[str, Any] = {"calibration": {"positions": positions, "scores": scores}}
+    if turn_headings:
+        calibration["turn_calibration"] = {"positions": places.round(4).tolist(), "scores": turns}
+    atlas.save(path, metadata=calibration)
+    return {"spots": len(pts), "calibration_frames": len(scores), "turns": len(turns)}
 
 
-def calibration_points(spots: np.ndarray) -> np.ndarray:
+def turn_scores(
+    room: AiboRoomEnv,
+    atlas: CompassAtlas,
+    camera: Camera,
+    position: Sequence[float],
+    start_deg: float,
+    headings: int,
+    frames: int,
+    seed: int,
+) -> np.ndarray:
+    """Every spot's raw score averaged over a turn on the spot.
+
+    The robot is put at ``position`` facing ``start_deg + k·360/headings`` for
+    ``k = 0 … headings−1`` and takes ``frames`` frames (head scanning) at each.
+    """
+    raws = [
+        atlas.scores(image, camera)[0]
+        for k in range(headings)
+        for image, _, _ in look(
+            room,
+            (float(position[0]), float(position[1]), start_deg + k * 360.0 / headings),
+            frames,
+            seed=seed + k,
+        )
+    ]
+    return np.mean(raws, axis=0)
+
+
+def calibration_points(spots: np.ndarray, bounds: Sequence[float] | None = None) -> np.ndarray:
     """The spots and the midpoints between neighbouring spots: where a robot that walks
-    from spot to spot while learning passes, knowing by odometry where it is."""
+    from spot to spot while learning passes, knowing by odometry where it is.
+
+    With the field's ``bounds`` also border points: every outermost spot of a row or
+    column moved out to :data:`BORDER_MARGIN_M` inside the field's edge (and the four
+    corners), so that calibration also covers the strip beyond the outer spots.
+    """
     pts = np.asarray(spots, np.float64)
+    border = _border_points(pts, bounds) if bounds is not None else np.zeros((0, 2))
     d = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
     nearest = np.min(np.where(d > 0, d, np.inf), axis=1)
     mids = [
@@ -139,13 +228,44 @@ def calibration_points(spots: np.ndarray) -> np.ndarray:
         for j in range(i + 1, len(pts))
         if d[i, j] <= 1.01 * max(nearest[i], nearest[j])
     ]
-    return np.vstack([pts, *mids]) if mids else pts
+    out = np.vstack([pts, *mids]) if mids else pts
+    extra = [p for p in border if not np.any(np.all(np.abs(out - p) < 1e-6, axis=1))]
+    return np.vstack([out, *extra]) if extra else out
+
+
+def _border_points(pts: np.ndarray, bounds: Sequence[float]) -> np.ndarray:
+    x0, x1, y0, y1 = (float(v) for v in bounds)
+    m = BORDER_MARGIN_M
+    lo_x, hi_x, lo_y, hi_y = x0 + m, x1 - m, y0 + m, y1 - m
+    out = []
+    for y in np.unique(pts[:, 1]):
+        row = pts[pts[:, 1] == y, 0]
+        out += [(lo_x, y)] if row.min() > lo_x + 1e-6 else []
+        out += [(hi_x, y)] if row.max() < hi_x - 1e-6 else []
+    for x in np.unique(pts[:, 0]):
+        col = pts[pts[:, 0] == x, 1]
+        out += [(x, lo_y)] if col.min() > lo_y + 1e-6 else []
+        out += [(x, hi_y)] if col.max() < hi_y - 1e-6 else []
+    out += [(lo_x, lo_y), (lo_x, hi_y), (hi_x, lo_y), (hi_x, hi_y)]
+    seen: list[tuple[float, float]] = []
+    for p in out:
+        if all(abs(p[0] - q[0]) > 1e-6 or abs(p[1] - q[1]) > 1e-6 for q in seen):
+            seen.append(p)
+    return np.array(seen, np.float64)
 
 
 def locate_job(
-    scene: str, atlas: str, poses: list[list[float]], frames: int, seed: int
+    scene: str,
+    atlas: str,
+    poses: list[list[float]],
+    frames: int,
+    seed: int,
+    turn_headings: int = 0,
+    turn_frames: int = 1,
 ) -> dict[str, Any]:
-    """Job: every spot's raw score (mean over the frames) at each pose of one position."""
+    """Job: every spot's raw score (mean over the frames) at each pose of one position,
+    and with ``turn_headings`` the scores averaged over a turn there (from each pose's
+    heading)."""
     room = _room(scene)
     loaded = worker_cache(("atlas", atlas), lambda: CompassAtlas.load(atlas))
     camera = Camera(hfov_deg=room.camera.hfov_deg)
@@ -155,7 +275,20 @@ def locate_job(
             loaded.scores(image, camera)[0]
             for image, _, _ in look(room, tuple(pose), frames, seed=seed + k)
         ]
-        out.append({"pose": pose, "scores": np.mean(raws, axis=0).round(6).tolist()})
+        view = {"pose": pose, "scores": np.mean(raws, axis=0).round(6).tolist()}
+        if turn_headings:
+            turn = turn_scores(
+                room,
+                loaded,
+                camera,
+                pose[:2],
+                float(pose[2]),
+                turn_headings,
+                turn_frames,
+                seed=seed + 500 + 20 * k,
+            )
+            view["turn_scores"] = turn.round(6).tolist()
+        out.append(view)
     return {"views": out}
 
 
@@ -234,6 +367,37 @@ def locate_calibrated(
     return mean, std
 
 
+def locate_nearest(
+    scores: np.ndarray,
+    places: np.ndarray,
+    place_scores: np.ndarray,
+    sigma: np.ndarray,
+    k: int = NEAREST_K,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Position from the ``k`` places whose score signatures are nearest.
+
+    Signature distance: Euclidean over spots of ``(scores − place_scores) / sigma``;
+    weights ``∝ 1 / distance``. Returns the weighted mean position and the per-axis
+    weighted spread of the ``k`` places (at least :data:`GRID_STEP_M`).
+    """
+    places = _array("places", places, (None, 2))
+    place_scores = _array("place_scores", place_scores, (places.shape[0], None))
+    n = place_scores.shape[1]
+    scores = _array("scores", scores, (n,))
+    sigma = _array("sigma", sigma, (n,))
+    if np.any(sigma <= 0):
+        raise ValueError("sigma must be > 0")
+    if isinstance(k, bool) or not isinstance(k, int | np.integer) or k < 1:
+        raise ValueError(f"k must be an int >= 1, got {k!r}")
+    d = np.sqrt((((place_scores - scores[None, :]) / sigma[None, :]) ** 2).sum(axis=1))
+    nearest = np.argsort(d, kind="stable")[: min(k, len(d))]
+    w = 1.0 / (d[nearest] + 1e-9)
+    w /= w.sum()
+    mean = w @ places[nearest]
+    std = np.sqrt(np.maximum(w @ (places[nearest] - mean) ** 2, GRID_STEP_M**2))
+    return mean, std
+
+
 def locate_eq30(scores: np.ndarray, spots: np.ndarray, sharpness: float) -> np.ndarray:
     """Eq. 30 over every spot: weights ``∝ exp(sharpness · score)``."""
     spots = _array("spots", spots, (None, 2))
@@ -279,6 +443,8 @@ def run_localization(
         "spots": spot_list,
         "steps": size["steps"],
         "calibration_headings": size["calibration_headings"],
+        "turn_headings": size["turn_headings"],
+        "turn_frames": size["turn_frames"],
         "seed": opts.seed,
     }
     digest = hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:10]
@@ -306,7 +472,9 @@ def run_localization(
                 "atlas": path,
                 "poses": [[round(float(v), 4) for v in p] for p in poses[i * h : (i + 1) * h]],
                 "frames": size["frames"],
-                "seed": int(opts.seed * 1_000_000 + 1000 + i * 10),
+                "seed": int(opts.seed * 1_000_000 + 1000 + i * 1000),
+                "turn_headings": size["turn_headings"],
+                "turn_frames": size["turn_frames"],
             },
         )
         for i in range(len(test))
@@ -330,32 +498,67 @@ def run_localization(
     if views:
         true = np.array([v["pose"][:2] for v in views])
         scores = np.array([v["scores"] for v in views])
-        eq30 = np.array([locate_eq30(s, atlas.positions, atlas.sharpness) for s in scores])
-        calibrated = [locate_calibrated(s, atlas.positions, model, bounds) for s in scores]
-        cal_mean = np.array([m for m, _ in calibrated])
-        cal_std = np.array([s for _, s in calibrated])
-        for name, est in (("paper", eq30), ("calibrated", cal_mean)):
-            err = np.hypot(*(est - true).T)
-            results["methods"][name] = {
-                "mean_error_m": round(float(err.mean()), 4),
-                "median_error_m": round(float(np.median(err)), 4),
-                "p90_error_m": round(float(np.percentile(err, 90)), 4),
-                "estimates": est.round(4).tolist(),
+        spots = atlas.positions
+        estimates: dict[str, tuple[np.ndarray, np.ndarray | None]] = {
+            "paper": (np.array([locate_eq30(s, spots, atlas.sharpness) for s in scores]), None),
+            "calibrated": _stacked([locate_calibrated(s, spots, model, bounds) for s in scores]),
+        }
+        if "turn_calibration" in meta and all("turn_scores" in v for v in views):
+            places = np.array(meta["turn_calibration"]["positions"])
+            place_scores = np.array(meta["turn_calibration"]["scores"])
+            turn_model = calibrate(spots, places, place_scores)
+            turns = np.array([v["turn_scores"] for v in views])
+            estimates["turn_calibrated"] = _stacked(
+                [locate_calibrated(s, spots, turn_model, bounds) for s in turns]
+            )
+            estimates["turn_nearest"] = _stacked(
+                [locate_nearest(s, places, place_scores, turn_model[2]) for s in turns]
+            )
+            results["turn_calibration"] = {
+                "sigma": turn_model[2].round(5).tolist(),
+                "length_m": turn_model[3],
+                "places": len(places),
+                "nearest_k": NEAREST_K,
             }
-        z = np.abs(cal_mean - true) / np.maximum(cal_std, 1e-6)
-        results["methods"]["calibrated"]["within_2_sigma"] = round(
-            float(np.mean(np.all(z <= 2.0, axis=1))), 4
-        )
-        results["methods"]["calibrated"]["mean_std_m"] = cal_std.mean(axis=0).round(4).tolist()
+        for name, (est, std) in estimates.items():
+            results["methods"][name] = _errors(est, std, true)
         results["true_positions"] = true.round(4).tolist()
         _plot(
             run.out / "localization.png",
             true,
-            {"paper (eq. 30)": eq30, "calibrated": cal_mean},
-            atlas.positions,
+            {PLOT_NAMES[name]: est for name, (est, _) in estimates.items()},
+            spots,
             bounds,
         )
     return run.finish(results)
+
+
+#: Panel titles of the methods in the PNG.
+PLOT_NAMES = {
+    "paper": "paper (eq. 30, one view)",
+    "calibrated": "calibrated (one view)",
+    "turn_calibrated": "calibrated (full turn)",
+    "turn_nearest": "nearest signatures (full turn)",
+}
+
+
+def _stacked(located: Sequence[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    return np.array([m for m, _ in located]), np.array([s for _, s in located])
+
+
+def _errors(est: np.ndarray, std: np.ndarray | None, true: np.ndarray) -> dict[str, Any]:
+    err = np.hypot(*(est - true).T)
+    out: dict[str, Any] = {
+        "mean_error_m": round(float(err.mean()), 4),
+        "median_error_m": round(float(np.median(err)), 4),
+        "p90_error_m": round(float(np.percentile(err, 90)), 4),
+        "estimates": est.round(4).tolist(),
+    }
+    if std is not None:
+        z = np.abs(est - true) / np.maximum(std, 1e-6)
+        out["within_2_sigma"] = round(float(np.mean(np.all(z <= 2.0, axis=1))), 4)
+        out["mean_std_m"] = std.mean(axis=0).round(4).tolist()
+    return out
 
 
 def _plot(
@@ -367,10 +570,14 @@ def _plot(
 ) -> None:
     from matplotlib.patches import Rectangle
 
-    fig = new_figure(figsize=(6 * len(estimates), 4.6), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(1, len(estimates)))
+    cols = min(2, len(estimates))
+    rows = -(-len(estimates) // cols)
+    fig = new_figure(figsize=(6 * cols, 4.3 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
+    for ax in axes[len(estimates) :]:
+        ax.set_visible(False)
     x0, x1, y0, y1 = bounds
-    for ax, (name, est) in zip(axes, estimates.items(), strict=True):
+    for ax, (name, est) in zip(axes, estimates.items(), strict=False):
         err = np.hypot(*(est - true).T)
         sc = ax.scatter(
             true[:, 0],
