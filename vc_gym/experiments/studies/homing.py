@@ -449,13 +449,14 @@ def _plot_stops(path: Path, episodes, settings, overall) -> None:
 def summary_lines(results: dict[str, Any]) -> list[str]:
     """The homing result in a few lines, next to the paper's."""
     mode = results.get("settings", {}).get("mode", "paper")
-    lines = [f"mode: {mode} (how the place is learned)"]
+    lines = [f"mode: {mode} (how the place is learned and the robot homes)"]
     for p in results.get("per_seed", []):
         lines.append(
             f"learning seed {p['seed']}: {p['episodes']} kidnappings, mean stop offset "
             f"{p['mean_stop_offset_cm']} cm, std {p['std_stop_offset_cm']} cm, mean distance "
             f"{p['mean_stop_distance_cm']} cm, success {p['success_rate']:.0%}, "
-            f"{p['far_stops']} stops > 50 cm"
+            f"{p['far_stops']} stops > 50 cm, {p['timed_out']} timed out, mean homing time "
+            f"{p['mean_homing_time_s']} s"
         )
     o = results.get("overall")
     if o and len(results.get("per_seed", [])) > 1:

@@ -577,6 +577,10 @@ def _plot(
     for ax in axes[len(estimates) :]:
         ax.set_visible(False)
     x0, x1, y0, y1 = bounds
+    # one colour scale for every panel, so that colours compare across methods
+    vmax = max(
+        1.0, *(float(np.percentile(np.hypot(*(e - true).T), 95)) for e in estimates.values())
+    )
     for ax, (name, est) in zip(axes, estimates.items(), strict=False):
         err = np.hypot(*(est - true).T)
         sc = ax.scatter(
@@ -585,7 +589,7 @@ def _plot(
             c=err,
             cmap="viridis_r",
             vmin=0,
-            vmax=max(1.0, float(np.percentile(err, 95))),
+            vmax=vmax,
             s=40,
         )
         ax.quiver(
