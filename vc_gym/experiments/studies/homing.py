@@ -437,7 +437,8 @@ def _plot_stops(path: Path, episodes, settings, overall) -> None:
     ax.set_ylabel("y offset from home (cm)")
     tracker = settings["tracker"] if isinstance(settings["tracker"], str) else "custom"
     ax.set_title(
-        f"{settings['agent']} ({tracker} tracker), {overall['episodes']} kidnappings:\n"
+        f"{settings['agent']} ({tracker} tracker, {settings.get('mode', 'paper')} mode), "
+        f"{overall['episodes']} kidnappings:\n"
         f"success {overall['success_rate']:.0%}, mean distance "
         f"{overall['mean_stop_distance_cm']:.0f} cm, {overall['far_stops']} stops > 50 cm",
         fontsize=10,
