@@ -209,6 +209,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "relearn": getattr(args, "relearn", None),
         "field": getattr(args, "field", None),
         "mode": getattr(args, "mode", None),
+        "modes": getattr(args, "modes", None),
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -641,6 +642,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="homing: paper (the paper's procedure, default) or improved (the spots "
         "normalised with the frames of the first turn at the true home; the scripted agent "
         "checks home with a full turn before it stops)",
+    )
+    p.add_argument(
+        "--modes",
+        type=_str_list,
+        metavar="MODE,...",
+        help="orientation, environments: paper (one spot, default) and/or improved (the same "
+        "learning at every spot of a 1.5 m grid; heading from the best-fitting map), "
+        "e.g. --modes paper,improved",
     )
     p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")

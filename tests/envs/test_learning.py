@@ -9,7 +9,13 @@ import pytest
 import vc_gym  # noqa: F401
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, VisualCompass
-from vc_gym.envs.learning import LearningConfig, ScriptedLearner, SpotLearning, kidnap_pose
+from vc_gym.envs.learning import (
+    GridLearning,
+    LearningConfig,
+    ScriptedLearner,
+    SpotLearning,
+    kidnap_pose,
+)
 
 
 def test_loop_closure_calibrates_odometry_turns():
@@ -124,3 +130,40 @@ def test_normalising_with_the_first_turn_puts_home_at_the_true_home():
         errors[where] = float(np.hypot(*np.mean(positions, axis=0)))
     assert errors["start"] < 0.05
     assert errors["start"] < errors["return"]
+
+
+def test_grid_learning_shares_colours_and_knows_each_spot():
+    spots = [(-0.75, 0.0), (0.75, 0.0), (-2.25, 1.5)]
+    env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+    room = env.unwrapped
+    room.reset(seed=0)
+    result = GridLearning(spots)(room, LearningConfig(learn_time_s=0.5))
+    atlas = result.atlas
+    assert atlas.names == ("spot0", "spot1", "spot2") and atlas.home == "spot0"
+    assert atlas.positions.tolist() == [list(p) for p in spots] and not atlas.is_normalized
+    assert all(vc.colors is atlas.compasses[0].colors for vc in atlas.compasses)
+    assert len(result.true_path) == 3 * 8 * 5
+    camera = Camera(hfov_deg=room.camera.hfov_deg)
+    for k, (x, y) in enumerate(spots):  # at each spot its own map fits best, heading right
+        yaw = 30.0 + 100.0 * k
+        obs, _ = room.reset(seed=10 + k, options={"pose": (x, y, yaw)})
+        est = atlas.estimate_position(obs["image"], camera)
+        best = max(est.goodness, key=est.goodness.get)
+        assert best == f"spot{k}"
+        assert abs(wrap180(est.estimates[best].heading_deg - yaw)) < 5.0
+    env.close()
+
+
+@pytest.mark.parametrize("bad", [[], [(0.0, 0.0), (0.0, 0.0)], [(1.0,)], "ab", [(0.0, np.inf)]])
+def test_grid_learning_rejects_bad_spots(bad):
+    with pytest.raises(ValueError, match="spots"):
+        GridLearning(bad)
+
+
+def test_learn_turn_rejects_colours_of_the_wrong_kind():
+    env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+    room = env.unwrapped
+    room.reset(seed=0)
+    with pytest.raises(ValueError, match="ColorClasses"):
+        ScriptedLearner(room, LearningConfig(learn_time_s=0.1)).learn_turn(colors="red")
+    env.close()

@@ -155,6 +155,9 @@ def test_a_dead_worker_fails_its_jobs_clearly_not_the_run(homing_quick, tmp_path
         (["experiment", "homing", "--backend", "local", "--address", "auto"], "address"),
         (["experiment", "homing", "--atlas", "/no/such/folder"], "not a folder"),
         (["experiment", "homing", "--seeds", "1,1"], "distinct"),
+        (["experiment", "homing", "--modes", "improved"], "does not take --modes"),
+        (["experiment", "orientation", "--modes", "paper,better"], "unknown mode"),
+        (["experiment", "orientation", "--modes", "paper,paper"], "distinct"),
     ],
 )
 def test_bad_arguments_fail_before_any_work(tmp_path, capsys, argv, message):
@@ -180,3 +183,22 @@ def test_bench_backends_measures_every_backend_on_the_same_jobs():
     assert all(run["jobs"] == 2 and run["jobs_per_s"] > 0 for run in r["runs"].values())
     assert set(r["speedup_vs_one_local_worker"]) == expected - {"local-1"}
     assert r["identical_results"]
+
+
+def test_orientation_in_both_modes(tmp_path, capsys):
+    out = tmp_path / "orient"
+    argv = ["experiment", "orientation", "--out", str(out), *QUICK, "--tracker", "grid"]
+    assert main([*argv, "--modes", "paper,improved"]) == 0
+    r = json.loads((out / "results.json").read_text())
+    assert set(r["modes"]) == {"paper", "improved"} and "scenes" not in r
+    paper, improved = (r["modes"][m]["scenes"]["robolab"] for m in ("paper", "improved"))
+    assert paper["training_spot"] == [-1.5, 0.0]
+    assert len(improved["spots"]) == 12 and improved["spots"][0] == [-2.25, 0.0]
+    # distances are from the nearest of 12 spots 1.5 m apart: never beyond ~1.1 m
+    for row in improved["trackers"]["grid"]["by_distance"]:
+        assert row["bin_end_m"] <= 1.5
+    assert {"grid", "compass"} <= set(improved["trackers"])
+    assert (out / "arrow_field_improved.png").is_file()
+    assert (out / "error_vs_distance_improved.png").is_file()
+    text = capsys.readouterr().out
+    assert "improved mode:" in text and "12 spots" in text

@@ -10,6 +10,7 @@ from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
 from vc_gym.envs.homing import HomingFeatures, StopAction, make_homing_env
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.learning import (
+    GridLearning,
     Learner,
     LearningConfig,
     LearningResult,
@@ -34,6 +35,7 @@ __all__ = [
     "SCENES",
     "AiboRoomEnv",
     "CompassObservation",
+    "GridLearning",
     "HeadCameraSpec",
     "HomingFeatures",
     "LEARNING_MODES",

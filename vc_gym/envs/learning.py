@@ -23,7 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from vc_gym.angles import interp_circular, wrap180, wrap360
-from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
+from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
 from vc_gym.validation import finite_float, positive_float
@@ -40,6 +40,7 @@ __all__ = [
     "ScriptedLearner",
     "ScriptedLearning",
     "SpotLearning",
+    "GridLearning",
     "kidnap_pose",
 ]
 
@@ -230,7 +231,9 @@ class ScriptedLearner:
         """Frames learned per direction: ``learn_time_s`` at the room's control rate."""
         return max(1, int(round(self.config.learn_time_s / self.dt)))
 
-    def learn_turn(self, steps: int | None = None) -> VisualCompass:
+    def learn_turn(
+        self, steps: int | None = None, colors: ColorClasses | None = None
+    ) -> VisualCompass:
         """Learn the map of the spot the robot stands on in one full turn (paper 4.3).
 
         The robot turns a full circle in 8 steps of 45°, ``steps`` frames per
@@ -250,6 +253,9 @@ class ScriptedLearner:
         steps : int, optional
             Frames per direction; default ``round(learn_time_s / control_dt)``
             (at least 1).
+        colors : ColorClasses, optional
+            Colour classes to learn with (e.g. another spot's, so that the goodness of
+            the spots compares); default: fitted on the turn's frames.
 
         Returns
         -------
@@ -273,7 +279,9 @@ class ScriptedLearner:
         self.home_compass = None
         self.rot_scale = 1.0
         self._scan_i = 0
-        self._learn_home(int(steps))
+        if colors is not None and not isinstance(colors, ColorClasses):
+            raise ValueError(f"colors must be ColorClasses, got {type(colors).__name__}")
+        self._learn_home(int(steps), colors)
         return self.home_compass
 
     def _normalise(self, atlas: CompassAtlas) -> None:
@@ -330,7 +338,7 @@ class ScriptedLearner:
             self._normalise(atlas)
         return LearningResult(atlas, spots, path, self.rot_scale)
 
-    def _learn_home(self, steps: int) -> None:
+    def _learn_home(self, steps: int, colors: ColorClasses | None = None) -> None:
         """Learn the home map in a full turn and calibrate the odometry's turns.
 
         The robot turns a full circle in 8 steps of 45°, scanning with its head, and
@@ -355,10 +363,11 @@ class ScriptedLearner:
         for _ in range(3):
             self._act()
         self._home_frames = [image for image, _, _, _ in frames]
-        per_direction = {}
-        for image, _, _, k in frames:
-            per_direction.setdefault(k, image)
-        colors = VisualCompass(cfg.compass).fit_colors(list(per_direction.values())).colors
+        if colors is None:
+            per_direction = {}
+            for image, _, _, k in frames:
+                per_direction.setdefault(k, image)
+            colors = VisualCompass(cfg.compass).fit_colors(list(per_direction.values())).colors
         first = VisualCompass(cfg.compass, colors)
         for image, turn, pan, k in frames:
             if k == 0:
@@ -393,6 +402,11 @@ class ScriptedLearning:
 
     def __call__(self, room, config: LearningConfig) -> LearningResult:
         return ScriptedLearner(room, config, progress=self.progress).learn()
+
+
+def _check_config(config: object) -> None:
+    if not isinstance(config, LearningConfig):
+        raise ValueError(f"config must be a LearningConfig, got {type(config).__name__}")
 
 
 class SpotLearning:
@@ -450,8 +464,7 @@ class SpotLearning:
         RobotFell
             If the robot falls (only with ``locomotion="dynamic"``).
         """
-        if not isinstance(config, LearningConfig):
-            raise ValueError(f"config must be a LearningConfig, got {type(config).__name__}")
+        _check_config(config)
         room.reset(options={"pose": (*self.spot, 0.0)})
         learner = ScriptedLearner(room, config)
         compass = learner.learn_turn()
@@ -460,6 +473,68 @@ class SpotLearning:
         return LearningResult(
             atlas, {self.name: self.spot}, list(learner.turn_path), learner.rot_scale
         )
+
+
+class GridLearning:
+    """A learner for maps on a grid of spots: the paper's spot learning at every spot.
+
+    At each spot in turn the robot is placed facing 0° and learns the panorama in a full
+    turn, as :class:`SpotLearning` does (8 × 45°, ``learn_time_s`` each with head
+    scanning, odometry loop closure). The colour classes are fitted at the first spot
+    and shared by every map, so the spots' raw scores compare (eq. 28). The first spot
+    is the atlas' home. The atlas is not normalised: normalising at one place (paper
+    5.2) makes every spot fit equally well *there*, so the map that fits best could no
+    longer be told at that spot.
+
+    Parameters
+    ----------
+    spots : sequence of (x, y)
+        The training spots, world metres; the first is home. At most 64.
+    """
+
+    #: Spot names are this prefix and the spot's index.
+    prefix = "spot"
+
+    def __init__(self, spots):
+        try:
+            pts = [(finite_float("spot x", x), finite_float("spot y", y)) for x, y in spots]
+        except (TypeError, ValueError):
+            raise ValueError(f"spots must be (x, y) pairs in metres, got {spots!r}") from None
+        if not 1 <= len(pts) <= 64 or len(set(pts)) != len(pts):
+            raise ValueError(f"spots must be 1 to 64 distinct (x, y) pairs, got {len(pts)}")
+        self.spots = pts
+
+    def __repr__(self) -> str:
+        return f"GridLearning(spots={self.spots})"
+
+    def __call__(self, room, config: LearningConfig) -> LearningResult:
+        """Learn every spot on ``room`` (``AiboRoomEnv``, unwrapped) with ``config``.
+
+        Returns
+        -------
+        LearningResult
+            ``atlas``: the spots ``spot0``, ``spot1``, ... at their positions, home
+            ``spot0``, not normalised; ``spots``; ``true_path``: the true poses of every
+            turn's frames; ``odometry_turn_scale``: the first spot's loop closure.
+
+        Raises
+        ------
+        RobotFell
+            If the robot falls (only with ``locomotion="dynamic"``).
+        """
+        _check_config(config)
+        maps, path, colors, scale = {}, [], None, 1.0
+        for i, spot in enumerate(self.spots):
+            room.reset(options={"pose": (*spot, 0.0)})
+            learner = ScriptedLearner(room, config)
+            compass = learner.learn_turn(colors=colors)
+            if colors is None:
+                colors, scale = compass.colors, learner.rot_scale
+            maps[f"{self.prefix}{i}"] = (spot, compass)
+            path.extend(learner.turn_path)
+        atlas = CompassAtlas(maps, home=f"{self.prefix}0")
+        names = {n: p for n, (p, _) in maps.items()}
+        return LearningResult(atlas, names, path, scale)
 
 
 def kidnap_pose(

@@ -22,14 +22,14 @@ from typing import Any
 import gymnasium as gym
 
 from vc_gym.compass import CompassAtlas, CompassConfig
-from vc_gym.envs.learning import LearningConfig, LearningResult, SpotLearning
+from vc_gym.envs.learning import GridLearning, LearningConfig, LearningResult, SpotLearning
 from vc_gym.errors import MapFileError
 from vc_gym.experiments.runner import ExperimentRun, Job
 from vc_gym.persistence import write_atomic
 
 __all__ = ["SavedAtlas", "atlas_key", "atlas_spec", "ensure_atlases", "learn_atlas_job"]
 
-LEARNERS = ("scripted", "spot")
+LEARNERS = ("scripted", "spot", "grid")
 
 
 def atlas_spec(
@@ -41,6 +41,7 @@ def atlas_spec(
     spot: Sequence[float] | None = None,
     room: Mapping[str, Any] | None = None,
     learning: Mapping[str, Any] | None = None,
+    spots: Sequence[Sequence[float]] | None = None,
 ) -> dict[str, Any]:
     """What identifies a learned atlas (a JSON dict; see :func:`learn_atlas_job`).
 
@@ -52,7 +53,8 @@ def atlas_spec(
         Seed of the learning phase (``LearnThenHome-v0.reset(seed=...)``).
     learner : str
         ``"scripted"``: the paper's four spots around home (5.2); ``"spot"``: one spot
-        learned in a full turn at ``spot`` (5.1).
+        learned in a full turn at ``spot`` (5.1); ``"grid"``: that at every one of
+        ``spots`` (:class:`~vc_gym.envs.learning.GridLearning`).
     learn_time_s : float
         Learning time per direction (paper: 5 s).
     compass : mapping, optional
@@ -64,11 +66,17 @@ def atlas_spec(
     learning : mapping, optional
         Learning options of ``vc_gym/LearnThenHome-v0`` that differ from the paper's
         (``{"normalise_at": "start"}``).
+    spots : sequence of (x, y), optional
+        The spots of the ``"grid"`` learner, the first one home.
     """
     if learner not in LEARNERS:
         raise ValueError(f"learner must be one of {LEARNERS}, got {learner!r}")
     if (learner == "spot") != (spot is not None):
         raise ValueError("spot is needed by, and only by, the 'spot' learner")
+    if (learner == "grid") != (spots is not None):
+        raise ValueError("spots are needed by, and only by, the 'grid' learner")
+    if spots is not None:
+        spots = [[float(x), float(y)] for x, y in GridLearning(spots).spots]
     config = CompassConfig(**dict(compass or {}))  # validates the fields
     learning = dict(learning or {})
     unknown = set(learning) - {"normalise_at"}
@@ -85,6 +93,8 @@ def atlas_spec(
     }
     if spot is not None:
         spec["spot"] = [float(v) for v in spot]
+    if spots is not None:
+        spec["spots"] = spots
     if learning:  # only when set: the paper's specs keep their keys
         spec["learning"] = learning
     json.dumps(spec, allow_nan=False)  # JSON values only
@@ -125,6 +135,8 @@ class SavedAtlas:
 def _learner(spec: Mapping[str, Any]):
     if spec["learner"] == "spot":
         return SpotLearning(tuple(spec["spot"]))
+    if spec["learner"] == "grid":
+        return GridLearning([tuple(p) for p in spec["spots"]])
     return None  # the task's default: the paper's scripted learning
 
 

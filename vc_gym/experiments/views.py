@@ -134,6 +134,16 @@ def _spot(spot: object) -> tuple[float, float]:
     return finite_float("spot x", x), finite_float("spot y", y)
 
 
+def spots_array(spot: object) -> np.ndarray:
+    """One spot ``(x, y)`` or several ``[(x, y), ...]`` as a finite ``(N, 2)`` array."""
+    a = np.asarray(spot, dtype=np.float64) if not isinstance(spot, str) else np.zeros(0)
+    if a.shape == (2,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != 2 or len(a) == 0 or not np.all(np.isfinite(a)):
+        raise ValueError(f"spot must be (x, y) or a list of (x, y), got {spot!r}")
+    return a
+
+
 # ---------------------------------------------------------------------- poses
 def field_grid(
     bounds: tuple[float, float, float, float], spacing_m: float, margin_m: float = 0.25
@@ -321,10 +331,11 @@ def evaluate_view(
     Each tracker is built with :func:`~vc_gym.localization.make_tracker` (a tracker
     instance is used as is), reset with ``atlas``, ``camera`` and ``dt_s``, and fed
     every frame in order; its final heading (eq. 25-26), spread (eq. 27) and error are
-    recorded. The single-frame compass of the atlas' *first* spot is added under the
-    name ``"compass"`` (:data:`COMPASS`): the estimate of the last frame alone (eq. 16,
-    no filter), turned from the camera's heading into the body's by subtracting the
-    head pan.
+    recorded. The single-frame compass is added under the name ``"compass"``
+    (:data:`COMPASS`): the estimate of the last frame alone (eq. 16, no filter) by the
+    atlas' one spot, or by the spot that fits the frame best (eq. 28) when there are
+    several, turned from the camera's heading into the body's by subtracting the head
+    pan.
 
     Parameters
     ----------
@@ -393,7 +404,11 @@ def evaluate_view(
         timing[str(name)] = 1e3 * elapsed / len(fr)
     image, pan, _ = fr[-1]
     t0 = time.perf_counter()
-    est = atlas.compasses[0].estimate(image, camera)
+    if len(atlas) == 1:
+        est = atlas.compasses[0].estimate(image, camera)
+    else:  # the map that fits the frame best (eq. 28)
+        found = atlas.estimate_position(image, camera)
+        est = found.estimates[max(found.goodness, key=found.goodness.get)]
     timing[COMPASS] = 1e3 * (time.perf_counter() - t0)
     figures[COMPASS] = record(est.heading_deg - pan, est.spread_deg)
     return figures, timing
@@ -581,8 +596,9 @@ def plot_arrow_field(
         ``(N, 3)`` true poses ``(x, y, yaw_deg)`` of the views.
     estimated_headings : array_like
         ``(N,)`` estimated body headings, degrees.
-    spot : tuple of float
-        The training spot ``(x, y)`` (marked with a star).
+    spot : tuple of float or sequence of them
+        The training spot ``(x, y)`` (marked with a star, with the paper's 2 m circle),
+        or several spots (marked with stars).
     field_bounds : tuple of float
         ``(xmin, xmax, ymin, ymax)`` of the field (drawn as its outline).
     title : str
@@ -598,7 +614,7 @@ def plot_arrow_field(
     est = np.asarray(estimated_headings, dtype=np.float64)
     if est.shape != (p.shape[0],) or not np.all(np.isfinite(est)):
         raise ValueError(f"estimated_headings must be {p.shape[0]} finite numbers")
-    sx, sy = _spot(spot)
+    spots = spots_array(spot)
     bounds = _bounds(field_bounds, "field_bounds")
     err = np.asarray(wrap180(est - p[:, 2]), dtype=np.float64)
     if reference_deg is None:
@@ -625,18 +641,28 @@ def plot_arrow_field(
         pivot="tail",
     )
     fig.colorbar(q, ax=ax, label="|heading error| (deg, clipped at 90)", shrink=0.8)
-    ax.plot([sx], [sy], marker="*", ms=16, c="red", mec="k", ls="none", label="training spot")
-    ax.add_patch(
-        Circle(
-            (sx, sy),
-            PAPER_RANGE_M,
-            fill=False,
-            ls=":",
-            ec="red",
-            lw=1,
-            label=f"{PAPER_RANGE_M:g} m (paper: error < {PAPER_ERROR_DEG:g}° inside)",
-        )
+    ax.plot(
+        spots[:, 0],
+        spots[:, 1],
+        marker="*",
+        ms=16 if len(spots) == 1 else 11,
+        c="red",
+        mec="k",
+        ls="none",
+        label="training spot" if len(spots) == 1 else "training spots",
     )
+    if len(spots) == 1:
+        ax.add_patch(
+            Circle(
+                tuple(spots[0]),
+                PAPER_RANGE_M,
+                fill=False,
+                ls=":",
+                ec="red",
+                lw=1,
+                label=f"{PAPER_RANGE_M:g} m (paper: error < {PAPER_ERROR_DEG:g}° inside)",
+            )
+        )
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(str(title))
     fig.tight_layout()

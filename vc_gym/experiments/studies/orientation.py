@@ -9,6 +9,12 @@ error and spread against the distance from the training spot (fig. 4 right; the
 paper: the mean error exceeds 10° only beyond 2 m) and the arrow field of the heading
 estimates (fig. 4 left).
 
+Modes (:data:`VIEW_MODES`): ``paper`` is the paper's single spot; ``improved`` learns
+the same way at every spot of a grid over the field (:data:`GRID_SPACING_M` apart,
+:class:`~vc_gym.envs.learning.GridLearning`, shared colour classes, home the spot
+nearest the paper's), so that the trackers take the heading from the map that fits
+best (eq. 28), and distances are measured from the nearest spot.
+
 :func:`view_job` and :func:`views_summary` are shared by the environments, parameter,
 illumination and tracker experiments.
 """
@@ -16,7 +22,6 @@ illumination and tracker experiments.
 from __future__ import annotations
 
 import json
-import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -45,11 +50,14 @@ from vc_gym.experiments.views import (
     look,
     plot_arrow_field,
     plot_error_vs_distance,
+    spots_array,
     view_poses,
 )
 
 __all__ = [
     "DEFAULT_TRACKERS",
+    "VIEW_MODES",
+    "training_spots",
     "HEADLINE",
     "headline_errors",
     "one_scene",
@@ -69,6 +77,25 @@ SIZES = {
     "paper": {"spacing_m": 0.5, "headings": 2, "frames": 10, "learn_time_s": 5.0},
     "full": {"spacing_m": 0.33, "headings": 3, "frames": 15, "learn_time_s": 5.0},
 }
+
+
+#: How the heading is learned over the field, by name (``--modes``).
+VIEW_MODES = ("paper", "improved")
+#: Spacing of the improved mode's grid of spots (metres) and its margin inside the field.
+GRID_SPACING_M = 1.5
+GRID_MARGIN_M = 0.5
+
+
+def training_spots(bounds: Sequence[float], mode: str = "paper") -> list[tuple[float, float]]:
+    """The spots a mode learns: the paper's one, or a grid with the one nearest it first."""
+    if mode not in VIEW_MODES:
+        raise ValueError(f"mode must be one of {list(VIEW_MODES)}, got {mode!r}")
+    centre = rear_half_centre(bounds)
+    if mode == "paper":
+        return [centre]
+    grid = field_grid(tuple(bounds), GRID_SPACING_M, margin_m=GRID_MARGIN_M)
+    order = np.argsort(np.hypot(grid[:, 0] - centre[0], grid[:, 1] - centre[1]), kind="stable")
+    return [(round(float(x), 4), round(float(y), 4)) for x, y in grid[order]]
 
 
 def rear_half_centre(bounds: Sequence[float]) -> tuple[float, float]:
@@ -103,7 +130,7 @@ def check_trackers(trackers: Sequence[Any] | Mapping[str, Any]) -> dict[str, Any
 def view_job(
     scene: str,
     atlas: str,
-    spot: list[float],
+    spot: list[float] | list[list[float]],
     poses: list[list[float]],
     frames: int,
     seed: int,
@@ -113,9 +140,11 @@ def view_job(
 ) -> dict[str, Any]:
     """Job: stand at every pose of one grid position; what each tracker believed.
 
-    Returns ``{"views": [{"pose", "distance_m", "estimates": {tracker: {...}}}],
-    "timing": {tracker: ms per update}}``; with ``time_learning`` the timing also holds
-    ``"learn"``: milliseconds to learn one frame into a map of the atlas' config.
+    ``spot`` is the training spot ``[x, y]`` or a list of them; ``distance_m`` is
+    measured from the nearest. Returns ``{"views": [{"pose", "distance_m", "estimates":
+    {tracker: {...}}}], "timing": {tracker: ms per update}}``; with ``time_learning`` the
+    timing also holds ``"learn"``: milliseconds to learn one frame into a map of the
+    atlas' config.
     """
     from vc_gym.envs.aibo_room import AiboRoomEnv
 
@@ -126,6 +155,7 @@ def view_job(
     )
     loaded = worker_cache(("atlas", atlas), lambda: CompassAtlas.load(atlas))
     camera = Camera(hfov_deg=env.camera.hfov_deg)
+    spots = spots_array(spot)
     views, costs = [], {}
     for k, pose in enumerate(poses):
         seen = look(env, tuple(pose), frames, seed=seed + k)
@@ -133,7 +163,9 @@ def view_job(
         views.append(
             {
                 "pose": [round(float(v), 4) for v in pose],
-                "distance_m": round(math.hypot(pose[0] - spot[0], pose[1] - spot[1]), 4),
+                "distance_m": round(
+                    float(np.min(np.hypot(spots[:, 0] - pose[0], spots[:, 1] - pose[1]))), 4
+                ),
                 "estimates": {
                     name: {k2: round(v, 4) for k2, v in est.items()}
                     for name, est in figures.items()
@@ -164,7 +196,7 @@ def view_jobs(
     prefix: str,
     scene: str,
     atlas: str,
-    spot: tuple[float, float],
+    spot: tuple[float, float] | Sequence[tuple[float, float]],
     bounds: Sequence[float],
     size: Mapping[str, Any],
     seed: int,
@@ -182,7 +214,7 @@ def view_jobs(
         kwargs = {
             "scene": scene,
             "atlas": atlas,
-            "spot": list(spot),
+            "spot": [list(p) for p in spot] if np.ndim(spot) == 2 else list(spot),
             "poses": [[round(float(v), 4) for v in p] for p in mine],
             "frames": size["frames"],
             "seed": int(seed * 1_000_000 + i * 100),
@@ -260,7 +292,7 @@ def plot_views(
     folder: Path,
     outputs: Sequence[Mapping[str, Any] | None],
     summary: Mapping[str, Any],
-    spot: tuple[float, float],
+    spot: tuple[float, float] | Sequence[tuple[float, float]],
     bounds: Sequence[float],
     title: str,
     arrows_for: str = "grid",
@@ -296,19 +328,28 @@ def orientation_stage(
     room: Mapping[str, Any] | None = None,
     stage: str | None = None,
     time_learning: bool = False,
-) -> tuple[list[dict[str, Any] | None], dict[str, Any], tuple[float, float], tuple]:
-    """Learn one spot in ``scene`` with ``compass`` and run the view jobs in ``room``.
+    mode: str = "paper",
+) -> tuple[list[dict[str, Any] | None], dict[str, Any], Any, tuple]:
+    """Learn ``mode``'s spots in ``scene`` with ``compass``; run the view jobs in ``room``.
 
-    The atlas is learned at full light (``room`` applies to the views only).
+    The atlas is learned at full light (``room`` applies to the views only). Returns the
+    jobs' outputs, their summary, the spot (``paper``: ``(x, y)``; else the list of
+    spots) and the field bounds.
     """
     bounds = scene_field_bounds(scene)
-    spot = rear_half_centre(bounds)
-    spec = atlas_spec(scene, opts.seed, "spot", size["learn_time_s"], compass, spot=spot)
+    spots = training_spots(bounds, mode)
+    if mode == "paper":
+        spot: Any = spots[0]
+        spec = atlas_spec(scene, opts.seed, "spot", size["learn_time_s"], compass, spot=spot)
+    else:
+        spot = spots
+        spec = atlas_spec(scene, opts.seed, "grid", size["learn_time_s"], compass, spots=spots)
     atlas_path = ensure_atlases(run, [spec], opts.atlas_dir)[atlas_key(spec)]
     jobs = view_jobs(
         "pos-", scene, atlas_path, spot, bounds, size, opts.seed, trackers, room, time_learning
     )
-    outputs = run.run(stage or f"views-{scene}", jobs)
+    default_stage = f"views-{scene}" if mode == "paper" else f"views-{mode}-{scene}"
+    outputs = run.run(stage or default_stage, jobs)
     return outputs, views_summary(outputs, list(trackers)), spot, bounds
 
 
@@ -317,6 +358,7 @@ def run_orientation(
     opts: ExperimentOptions | None = None,
     trackers: Sequence[Any] | None = None,
     scenes: Sequence[str] | None = None,
+    modes: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """Run the orientation experiment (5.1, fig. 4) and write its results and plots.
 
@@ -331,13 +373,16 @@ def run_orientation(
         always reported as ``"compass"``.
     scenes : sequence of str, optional
         Default ``["robolab"]`` (the paper's); one spot per scene.
+    modes : sequence of str, optional
+        :data:`VIEW_MODES` to run (default ``["paper"]``). With only ``paper`` the
+        results hold ``scenes``; otherwise ``modes: {mode: {"scenes": ...}}``.
 
     Returns
     -------
     dict
         The results written to ``results.json``.
     """
-    return _run_views("orientation", out_dir, opts, trackers, scenes or ["robolab"])
+    return _run_views("orientation", out_dir, opts, trackers, scenes or ["robolab"], modes)
 
 
 def run_environments(
@@ -345,6 +390,7 @@ def run_environments(
     opts: ExperimentOptions | None = None,
     trackers: Sequence[Any] | None = None,
     scenes: Sequence[str] | None = None,
+    modes: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """The orientation experiment in every registered scene (paper 5.3: other places).
 
@@ -354,26 +400,53 @@ def run_environments(
     """
     from vc_gym.envs.scenes import scene_names
 
-    return _run_views("environments", out_dir, opts, trackers, scenes or list(scene_names()))
+    return _run_views("environments", out_dir, opts, trackers, scenes or list(scene_names()), modes)
 
 
-def _run_views(name, out_dir, opts, trackers, scenes) -> dict[str, Any]:
+def _check_modes(modes: Sequence[str] | None) -> list[str]:
+    modes = ["paper"] if modes is None else modes
+    if isinstance(modes, str) or not modes or len(set(modes)) != len(list(modes)):
+        raise ValueError(f"modes must be distinct names from {list(VIEW_MODES)}, got {modes}")
+    for m in modes:
+        if m not in VIEW_MODES:
+            raise ValueError(f"unknown mode {m!r}; choose from {list(VIEW_MODES)}")
+    return list(modes)
+
+
+def _run_views(name, out_dir, opts, trackers, scenes, modes=None) -> dict[str, Any]:
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
     named = check_trackers(trackers or DEFAULT_TRACKERS)
     scenes = _check_scenes(scenes)
-    run = open_run(out_dir, name, opts, {"trackers": named, "scenes": scenes, **size})
+    modes = _check_modes(modes)
+    settings = {"trackers": named, "scenes": scenes, **size}
+    if modes != ["paper"]:
+        settings["modes"] = modes
+    run = open_run(out_dir, name, opts, settings)
     results: dict[str, Any] = {
         "paper": {"claim": "mean heading error < 10° within 2 m of the training spot"},
-        "scenes": {},
     }
-    for scene in scenes:
-        outputs, summary, spot, bounds = orientation_stage(run, opts, size, scene, named)
-        suffix = "" if len(scenes) == 1 else f"_{scene}"
-        plot_views(run.out, outputs, summary, spot, bounds, f"{scene}, spot {spot}", suffix=suffix)
-        results["scenes"][scene] = {"training_spot": list(spot), **summary}
-    if len(scenes) > 1:
-        _plot_scenes(run.out / "scenes.png", results["scenes"])
+    per_mode = {}
+    for mode in modes:
+        per_scene = {}
+        for scene in scenes:
+            outputs, summary, spot, bounds = orientation_stage(
+                run, opts, size, scene, named, mode=mode
+            )
+            suffix = ("" if len(scenes) == 1 else f"_{scene}") + (
+                "" if mode == "paper" else f"_{mode}"
+            )
+            where = f"spot {spot}" if mode == "paper" else f"{len(spot)} spots"
+            plot_views(run.out, outputs, summary, spot, bounds, f"{scene}, {where}", suffix=suffix)
+            entry = {"training_spot": list(spot)} if mode == "paper" else {"spots": spot}
+            per_scene[scene] = {**entry, **summary}
+        if len(scenes) > 1:
+            _plot_scenes(run.out / f"scenes{'' if mode == 'paper' else '_' + mode}.png", per_scene)
+        per_mode[mode] = per_scene
+    if modes == ["paper"]:
+        results["scenes"] = per_mode["paper"]
+    else:
+        results["modes"] = {m: {"scenes": per_mode[m]} for m in modes}
     return run.finish(results, _cost_info(run))
 
 
@@ -420,14 +493,25 @@ def _cost_info(run: ExperimentRun) -> dict[str, Any]:
 
 
 def summary_lines(results: Mapping[str, Any]) -> list[str]:
-    """Mean heading error within and beyond 2 m of the spot, per scene and tracker."""
+    """Mean heading error within and beyond 2 m of the spot, per mode, scene and tracker."""
+    if "modes" in results:
+        lines = []
+        for mode, r in results["modes"].items():
+            lines.append(f"{mode} mode:")
+            lines += ["  " + line for line in summary_lines({"scenes": r["scenes"]})]
+        for f in results.get("failed_jobs", []):
+            lines.append(f"FAILED {f['stage']}/{f['key']}: {f['error']}")
+        return lines
     lines = []
     for scene, r in results.get("scenes", {}).items():
-        lines.append(f"{scene} (spot {r['training_spot']}, {r['views']} views):")
+        where = f"spot {r['training_spot']}" if "training_spot" in r else f"{len(r['spots'])} spots"
+        lines.append(f"{scene} ({where}, {r['views']} views):")
         for name, t in r["trackers"].items():
+            beyond = t["mean_abs_error_beyond_2m_deg"]
             lines.append(
                 f"  {name:10s} mean |error| {t['mean_abs_error_within_2m_deg']}° within 2 m, "
-                f"{t['mean_abs_error_beyond_2m_deg']}° beyond; paper's claim (< 10° within "
+                + (f"{beyond}° beyond" if beyond is not None else "no view beyond")
+                + "; paper's claim (< 10° within "
                 f"2 m) {'holds' if t['paper_claim_holds'] else 'does not hold'}"
             )
     for f in results.get("failed_jobs", []):
