@@ -181,6 +181,11 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     else:
         for line in experiment.summary_lines(results):
             print(line)
+        run_info = (
+            json.loads((out / "run.json").read_text()) if (out / "run.json").is_file() else {}
+        )
+        for line in experiment.cost_lines(run_info):
+            print(line)
         print(f"wrote {out / 'results.json'}, {out / 'run.json'} and the plots in {out}")
     failed = results.get("failed_jobs") or []
     if failed:

@@ -88,3 +88,29 @@ def test_bad_atlas_arguments(room):
         atlas.estimate_position(img, Camera())
     with pytest.raises(ValueError):
         atlas.normalize([img, img], [Camera()])
+
+
+@pytest.mark.parametrize("pose", [(0.0, 0.0, 10.0), (0.7, -0.4, 200.0), (-1.2, 0.9, 290.0)])
+def test_all_spots_at_once_equal_each_compass_on_its_own(atlas, room, pose):
+    x, y, yaw = pose
+    image = render_room_view(room, x, y, Camera(yaw_deg=yaw))
+    raw, together = atlas.scores(image, Camera())
+    for vc, est, score in zip(atlas.compasses, together, raw, strict=True):
+        alone = vc.estimate(image, Camera())
+        np.testing.assert_array_equal(est.log_likelihood, alone.log_likelihood)
+        np.testing.assert_array_equal(est.log_likelihood, vc.log_likelihood(image, Camera()))
+        assert est.heading_deg == alone.heading_deg and est.score == alone.score == score
+        assert est.n_sectors == alone.n_sectors
+        assert est.spread_deg == pytest.approx(alone.spread_deg, rel=1e-9)
+    # a map that learns more gets new tables: the stacked ones follow
+    before = atlas.scores(image, Camera())[0]
+    extra = VisualCompass(atlas.compasses[0].config, atlas.compasses[0].colors)
+    extra.learn(image, Camera(yaw_deg=yaw))
+    grown = CompassAtlas(
+        {"a": ((0.0, 0.0), atlas.compasses[0]), "b": ((1.0, 0.0), extra)}, home="a"
+    )
+    first = grown.scores(image, Camera())[0]
+    extra.learn(render_room_view(room, x, y, Camera(yaw_deg=yaw + 90)), Camera(yaw_deg=yaw + 90))
+    second = grown.scores(image, Camera())[0]
+    assert first[0] == second[0] == before[0] and first[1] != second[1]
+    assert second[1] == extra.estimate(image, Camera()).score

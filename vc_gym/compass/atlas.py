@@ -18,7 +18,12 @@ import numpy as np
 
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
-from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
+from vc_gym.compass.visual_compass import (
+    CompassEstimate,
+    VisualCompass,
+    estimates_of,
+    log_likelihoods_of,
+)
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
@@ -131,6 +136,7 @@ class CompassAtlas:
         self._home_headings = np.zeros((0, len(names)))
         self._kappa = 1.0
         self.is_normalized = False
+        self._stacked: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray] | None = None
 
     def __len__(self) -> int:
         return len(self.names)
@@ -144,10 +150,23 @@ class CompassAtlas:
             for vc in self.compasses:
                 vc._checked(image, camera, need_map=True)
             features = first._sector_features(image, camera)
-            ests = [vc._estimate_of(*features) for vc in self.compasses]
+            delta_t, base = self._stacked_tables()
+            lls = log_likelihoods_of(first.config, *features, delta_t, base)
+            ests = estimates_of(self.compasses, *features, lls)
         else:
             ests = [vc.estimate(image, camera) for vc in self.compasses]
         return np.array([e.score for e in ests]), ests
+
+    def _stacked_tables(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every map's log tables stacked (``(M, c²·n, S)``, ``(M, S)``), rebuilt only
+        when a map's tables changed (a compass that learned more)."""
+        tables = [vc._log_tables() for vc in self.compasses]
+        deltas = tuple(t[0] for t in tables)
+        cached = self._stacked
+        if cached is None or any(a is not b for a, b in zip(cached[0], deltas, strict=True)):
+            cached = (deltas, np.stack(deltas), np.stack([t[1] for t in tables]))
+            self._stacked = cached
+        return cached[1], cached[2]
 
     def normalize(
         self,

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vc_gym.angles import circular_std, wrap360
+from vc_gym.angles import wrap360
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
@@ -429,26 +429,7 @@ class VisualCompass:
     ) -> np.ndarray:
         """Log-likelihood over headings from sector features (see log_likelihood)."""
         delta_t, base, _ = self._log_tables()
-        s_total = self.config.n_sectors
-        n = self.config.n_bins
-        seen = total > 0
-        if not seen.any():
-            return np.zeros(self._headings.size)
-        nz_group, nz_code = np.nonzero(counts)
-        z = counts[nz_group, nz_code] / total[nz_group]
-        rows = nz_code * n + log2_bin(z, n)
-        gathered = np.take(delta_t, rows, axis=0)  # (E, S)
-        starts = np.flatnonzero(np.r_[True, nz_group[1:] != nz_group[:-1]])
-        per_group = np.zeros((counts.shape[0], s_total))
-        per_group[nz_group[starts]] = np.add.reduceat(gathered, starts, axis=0)
-        per_group[seen] += base[None, :]
-        per_group = per_group.reshape(-1, geom.n_rel, s_total)  # (P, K, S) by absolute sector
-        # score[p, s0] = sum_k per_group[p, k, s0 + k + kmin]
-        by_start = per_group[:, np.arange(geom.n_rel)[:, None], geom.roll_index].sum(axis=1)
-        ll = by_start[geom.heading_phase, geom.heading_sector]
-        if self.config.temperature != 1.0:
-            ll = ll / self.config.temperature
-        return ll
+        return log_likelihoods_of(self.config, geom, counts, total, delta_t[None], base[None])[0]
 
     def estimate(self, image: np.ndarray, camera: Camera) -> CompassEstimate:
         """Best heading, its spread and the goodness of fit for one image.
@@ -459,40 +440,17 @@ class VisualCompass:
         return self._estimate_of(*self._sector_features(image, camera))
 
     def _estimate_of(
-        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
+        self,
+        geom: _Geometry,
+        counts: np.ndarray,
+        total: np.ndarray,
+        ll: np.ndarray | None = None,
     ) -> CompassEstimate:
-        """:meth:`estimate` from sector features (shared by compasses with one colour set)."""
-        ll = self._log_likelihood_of(geom, counts, total)
-        n_h = ll.size
-        best = int(np.argmax(ll))
-        step = self.config.heading_step_deg
-        y0, y1, y2 = ll[(best - 1) % n_h], ll[best], ll[(best + 1) % n_h]
-        denom = y0 - 2.0 * y1 + y2
-        frac = 0.5 * (y0 - y2) / denom if denom < 0 else 0.0
-        heading = float(wrap360(self._headings[best] + float(np.clip(frac, -0.5, 0.5)) * step))
-        post = np.exp(ll - ll[best])
-        spread = circular_std(self._headings, post)
-        score, n_sectors = self._score_at(geom, counts, total, best)
-        return CompassEstimate(heading, spread, score, n_sectors, ll)
-
-    def _score_at(
-        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray, heading_index: int
-    ) -> tuple[float, int]:
-        """Mean per-term log-probability at one heading and the number of sectors used."""
-        _, _, log_abs = self._log_tables()
-        p = geom.heading_phase[heading_index]
-        s0 = geom.heading_sector[heading_index]
-        k = geom.n_rel
-        c = counts[p * k : (p + 1) * k]
-        t = total[p * k : (p + 1) * k]
-        seen = np.flatnonzero(t > 0)
-        if seen.size == 0:
-            return 0.0, 0
-        z = c[seen] / t[seen, None]
-        bins = log2_bin(z, self.config.n_bins)
-        sectors = (s0 + seen + geom.kmin) % self.config.n_sectors
-        terms = log_abs[sectors[:, None], np.arange(c.shape[1])[None, :], bins]
-        return float(terms.mean()), int(seen.size)
+        """:meth:`estimate` from sector features (shared by compasses with one colour set)
+        and, when already computed, the log-likelihood over headings."""
+        if ll is None:
+            ll = self._log_likelihood_of(geom, counts, total)
+        return estimates_of([self], geom, counts, total, ll[None])[0]
 
     # ------------------------------------------------------------------ persistence
     def save(self, path: str | os.PathLike) -> Path:
@@ -626,3 +584,114 @@ class VisualCompass:
             f"VisualCompass(frames_learned={self._frames}, "
             f"learned={self.learned_fraction:.0%} of 360°, config={self.config})"
         )
+
+
+def log_likelihoods_of(
+    config: CompassConfig,
+    geom: _Geometry,
+    counts: np.ndarray,
+    total: np.ndarray,
+    delta_t: np.ndarray,
+    base: np.ndarray,
+) -> np.ndarray:
+    """Log-likelihood over headings (eq. 5, 15-16) of one frame under several maps.
+
+    The maps share ``config`` and colour classes, so the frame's sector features
+    (``geom``, ``counts``, ``total``) and which table rows they read are computed once;
+    ``delta_t`` ``(M, c²·n, S)`` and ``base`` ``(M, S)`` are the maps' stacked log
+    tables (:meth:`VisualCompass._log_tables`). Sums run in the same order for any
+    ``M``, so each map's row equals its own :meth:`VisualCompass.log_likelihood` bit
+    for bit. Returns ``(M, n_headings)``; all zeros where nothing was seen.
+    """
+    m = delta_t.shape[0]
+    s_total = config.n_sectors
+    n = config.n_bins
+    seen = total > 0
+    n_headings = geom.heading_phase.size
+    if not seen.any():
+        return np.zeros((m, n_headings))
+    nz_group, nz_code = np.nonzero(counts)
+    z = counts[nz_group, nz_code] / total[nz_group]
+    rows = nz_code * n + log2_bin(z, n)
+    gathered = np.take(delta_t, rows, axis=1)  # (M, E, S)
+    starts = np.flatnonzero(np.r_[True, nz_group[1:] != nz_group[:-1]])
+    per_group = np.zeros((m, counts.shape[0], s_total))
+    per_group[:, nz_group[starts]] = np.add.reduceat(gathered, starts, axis=1)
+    per_group[:, seen] += base[:, None, :]
+    per_group = per_group.reshape(m, -1, geom.n_rel, s_total)  # (M, P, K, S) by sector
+    # score[p, s0] = sum_k per_group[p, k, s0 + k + kmin]
+    by_start = per_group[:, :, np.arange(geom.n_rel)[:, None], geom.roll_index].sum(axis=2)
+    ll = by_start[:, geom.heading_phase, geom.heading_sector]
+    if config.temperature != 1.0:
+        ll = ll / config.temperature
+    return ll
+
+
+def estimates_of(
+    compasses: Sequence[VisualCompass],
+    geom: _Geometry,
+    counts: np.ndarray,
+    total: np.ndarray,
+    lls: np.ndarray,
+) -> list[CompassEstimate]:
+    """:class:`CompassEstimate` of one frame under each map, from its log-likelihoods.
+
+    ``lls`` is ``(M, n_headings)`` (:func:`log_likelihoods_of`). The best heading is
+    refined by a parabola through the peak and its neighbours, the spread is the
+    circular standard deviation of the posterior (eq. 27) and the score the mean
+    per-term log-probability at the best heading (eq. 28), all computed for the ``M``
+    maps at once.
+    """
+    first = compasses[0]
+    headings = first._headings
+    m, n_h = lls.shape
+    rows = np.arange(m)
+    best = np.argmax(lls, axis=1)
+    y0, y1, y2 = lls[rows, (best - 1) % n_h], lls[rows, best], lls[rows, (best + 1) % n_h]
+    denom = y0 - 2.0 * y1 + y2
+    peaked = denom < 0
+    frac = np.zeros(m)
+    frac[peaked] = 0.5 * (y0[peaked] - y2[peaked]) / denom[peaked]
+    step = first.config.heading_step_deg
+    heading = wrap360(headings[best] + np.clip(frac, -0.5, 0.5) * step)
+    post = np.exp(lls - y1[:, None])
+    a = np.radians(headings)
+    r = np.hypot((post * np.sin(a)).sum(axis=1), (post * np.cos(a)).sum(axis=1))
+    r = np.minimum(r / post.sum(axis=1), 1.0)
+    with np.errstate(divide="ignore"):
+        spread = np.where(r > 0.0, np.degrees(np.sqrt(np.maximum(-2.0 * np.log(r), 0.0))), np.inf)
+    scores, n_sectors = _scores_at(compasses, geom, counts, total, best)
+    return [
+        CompassEstimate(float(heading[k]), float(spread[k]), scores[k], n_sectors[k], lls[k])
+        for k in range(m)
+    ]
+
+
+def _scores_at(
+    compasses: Sequence[VisualCompass],
+    geom: _Geometry,
+    counts: np.ndarray,
+    total: np.ndarray,
+    best: np.ndarray,
+) -> tuple[list[float], list[int]]:
+    """Each map's goodness at its own best heading: the mean per-term log-probability
+    of the frame's features (eq. 28) and the number of sectors used; the frame's bins
+    are read once per heading phase."""
+    cfg = compasses[0].config
+    k_rel = geom.n_rel
+    scores, used = [0.0] * len(compasses), [0] * len(compasses)
+    phases = geom.heading_phase[best]
+    for p in np.unique(phases):
+        t = total[p * k_rel : (p + 1) * k_rel]
+        seen = np.flatnonzero(t > 0)
+        if seen.size == 0:
+            continue
+        c = counts[p * k_rel : (p + 1) * k_rel]
+        bins = log2_bin(c[seen] / t[seen, None], cfg.n_bins)  # (seen, c2)
+        pairs = np.arange(c.shape[1])[None, :]
+        for k in np.flatnonzero(phases == p):
+            log_abs = compasses[k]._log_tables()[2]
+            sectors = (geom.heading_sector[best[k]] + seen + geom.kmin) % cfg.n_sectors
+            scores[k] = float(log_abs[sectors[:, None], pairs, bins].mean())
+            used[k] = int(seen.size)
+    return scores, used

@@ -33,6 +33,11 @@ class Experiment:
     def summary_lines(self, results: dict[str, Any]) -> list[str]:
         return list(importlib.import_module(self.module).summary_lines(results))
 
+    def cost_lines(self, run_info: dict[str, Any]) -> list[str]:
+        """What the experiment says about cost, from its ``run.json`` (may be none)."""
+        lines = getattr(importlib.import_module(self.module), "cost_lines", None)
+        return list(lines(run_info)) if lines is not None else []
+
 
 _P = "vc_gym.experiments.studies."
 EXPERIMENTS: dict[str, Experiment] = {

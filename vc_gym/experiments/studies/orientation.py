@@ -61,6 +61,7 @@ __all__ = [
     "HEADLINE",
     "headline_errors",
     "one_scene",
+    "cost_lines",
     "rear_half_centre",
     "run_environments",
     "run_orientation",
@@ -447,7 +448,7 @@ def _run_views(name, out_dir, opts, trackers, scenes, modes=None) -> dict[str, A
         results["scenes"] = per_mode["paper"]
     else:
         results["modes"] = {m: {"scenes": per_mode[m]} for m in modes}
-    return run.finish(results, _cost_info(run))
+    return run.finish(results, _cost_info(run, modes))
 
 
 def _plot_scenes(path: Path, per_scene: Mapping[str, Any], tracker: str = "grid") -> None:
@@ -484,12 +485,59 @@ def _check_scenes(scenes: Sequence[str]) -> list[str]:
     return out
 
 
-def _cost_info(run: ExperimentRun) -> dict[str, Any]:
-    """Median ms per update of every tracker over all view jobs (for ``run.json``)."""
-    views = [
-        t for stage, jobs in run.timings.items() if stage.startswith("views") for t in jobs.values()
-    ]
-    return {"ms_per_update_median": median_timings(views)}
+def _cost_info(run: ExperimentRun, modes: Sequence[str] = ("paper",)) -> dict[str, Any]:
+    """Median ms per update of every tracker over the view jobs, overall and per mode
+    (for ``run.json``; :func:`cost_lines` prints them)."""
+
+    def stage_mode(stage: str) -> str:
+        parts = stage.split("-")
+        return parts[1] if len(parts) > 2 and parts[1] in VIEW_MODES else "paper"
+
+    views = {
+        stage: list(jobs.values())
+        for stage, jobs in run.timings.items()
+        if stage.startswith("views")
+    }
+    info: dict[str, Any] = {
+        "ms_per_update_median": median_timings([t for ts in views.values() for t in ts])
+    }
+    if list(modes) != ["paper"]:
+        info["ms_per_update_median_by_mode"] = {
+            m: median_timings([t for st, ts in views.items() if stage_mode(st) == m for t in ts])
+            for m in modes
+        }
+    return info
+
+
+def cost_lines(run_info: Mapping[str, Any]) -> list[str]:
+    """Cost per frame of every tracker (median ms per update, from ``run.json``); with
+    several modes, each mode's and its ratio to the paper mode's."""
+    by_mode = run_info.get("ms_per_update_median_by_mode")
+    if not by_mode:
+        costs = run_info.get("ms_per_update_median") or {}
+        return (
+            [
+                "cost per frame (median ms per update): "
+                + ", ".join(f"{n} {v:.2f}" for n, v in costs.items() if v is not None)
+            ]
+            if costs
+            else []
+        )
+    paper = by_mode.get("paper", {})
+    lines = ["cost per frame (median ms per update, this run):"]
+    for mode, costs in by_mode.items():
+        parts = []
+        for name, ms in costs.items():
+            if ms is None:
+                continue
+            ratio = (
+                f" (x{ms / paper[name]:.1f} of paper)"
+                if paper.get(name) and mode != "paper"
+                else ""
+            )
+            parts.append(f"{name} {ms:.2f}{ratio}")
+        lines.append(f"  {mode}: " + ", ".join(parts))
+    return lines
 
 
 def summary_lines(results: Mapping[str, Any]) -> list[str]:
