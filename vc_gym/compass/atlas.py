@@ -158,13 +158,13 @@ class CompassAtlas:
         return np.array([e.score for e in ests]), ests
 
     def _stacked_tables(self) -> tuple[np.ndarray, np.ndarray]:
-        """Every map's log tables stacked (``(M, c²·n, S)``, ``(M, S)``), rebuilt only
+        """Every map's log tables stacked (``(c²·n, M, S)``, ``(M, S)``), rebuilt only
         when a map's tables changed (a compass that learned more)."""
         tables = [vc._log_tables() for vc in self.compasses]
         deltas = tuple(t[0] for t in tables)
         cached = self._stacked
         if cached is None or any(a is not b for a, b in zip(cached[0], deltas, strict=True)):
-            cached = (deltas, np.stack(deltas), np.stack([t[1] for t in tables]))
+            cached = (deltas, np.stack(deltas, axis=1), np.stack([t[1] for t in tables]))
             self._stacked = cached
         return cached[1], cached[2]
 

@@ -429,7 +429,9 @@ class VisualCompass:
     ) -> np.ndarray:
         """Log-likelihood over headings from sector features (see log_likelihood)."""
         delta_t, base, _ = self._log_tables()
-        return log_likelihoods_of(self.config, geom, counts, total, delta_t[None], base[None])[0]
+        return log_likelihoods_of(
+            self.config, geom, counts, total, delta_t[:, None, :], base[None]
+        )[0]
 
     def estimate(self, image: np.ndarray, camera: Camera) -> CompassEstimate:
         """Best heading, its spread and the goodness of fit for one image.
@@ -598,33 +600,34 @@ def log_likelihoods_of(
 
     The maps share ``config`` and colour classes, so the frame's sector features
     (``geom``, ``counts``, ``total``) and which table rows they read are computed once;
-    ``delta_t`` ``(M, c²·n, S)`` and ``base`` ``(M, S)`` are the maps' stacked log
-    tables (:meth:`VisualCompass._log_tables`). Sums run in the same order for any
-    ``M``, so each map's row equals its own :meth:`VisualCompass.log_likelihood` bit
-    for bit. Returns ``(M, n_headings)``; all zeros where nothing was seen.
+    ``delta_t`` ``(c²·n, M, S)`` and ``base`` ``(M, S)`` are the maps' stacked log
+    tables (:meth:`VisualCompass._log_tables`; rows first, so that one read brings a
+    row of every map). Sums run in the same order for any ``M``, so each map's row
+    equals its own :meth:`VisualCompass.log_likelihood` bit for bit. Returns
+    ``(M, n_headings)``; all zeros where nothing was seen.
     """
-    m = delta_t.shape[0]
+    m = delta_t.shape[1]
     s_total = config.n_sectors
     n = config.n_bins
     seen = total > 0
-    n_headings = geom.heading_phase.size
     if not seen.any():
-        return np.zeros((m, n_headings))
+        return np.zeros((m, geom.heading_phase.size))
     nz_group, nz_code = np.nonzero(counts)
     z = counts[nz_group, nz_code] / total[nz_group]
     rows = nz_code * n + log2_bin(z, n)
-    gathered = np.take(delta_t, rows, axis=1)  # (M, E, S)
+    gathered = np.take(delta_t, rows, axis=0)  # (E, M, S)
     starts = np.flatnonzero(np.r_[True, nz_group[1:] != nz_group[:-1]])
-    per_group = np.zeros((m, counts.shape[0], s_total))
-    per_group[:, nz_group[starts]] = np.add.reduceat(gathered, starts, axis=1)
-    per_group[:, seen] += base[:, None, :]
-    per_group = per_group.reshape(m, -1, geom.n_rel, s_total)  # (M, P, K, S) by sector
-    # score[p, s0] = sum_k per_group[p, k, s0 + k + kmin]
-    by_start = per_group[:, :, np.arange(geom.n_rel)[:, None], geom.roll_index].sum(axis=2)
-    ll = by_start[:, geom.heading_phase, geom.heading_sector]
+    per_group = np.zeros((counts.shape[0], m, s_total))
+    per_group[nz_group[starts]] = np.add.reduceat(gathered, starts, axis=0)
+    per_group[seen] += base[None, :, :]
+    per_group = per_group.reshape(-1, geom.n_rel, m, s_total)  # (P, K, M, S) by sector
+    # score[p, m, s0] = sum_k per_group[p, k, m, s0 + k + kmin]; the advanced indices
+    # come first: (K, S, P, M), summed over K
+    by_start = per_group[:, np.arange(geom.n_rel)[:, None], :, geom.roll_index].sum(axis=0)
+    ll = by_start[geom.heading_sector, geom.heading_phase].T  # (M, n_headings)
     if config.temperature != 1.0:
         ll = ll / config.temperature
-    return ll
+    return np.ascontiguousarray(ll)
 
 
 def estimates_of(
