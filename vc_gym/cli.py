@@ -215,6 +215,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "field": getattr(args, "field", None),
         "mode": getattr(args, "mode", None),
         "modes": getattr(args, "modes", None),
+        "light": getattr(args, "light", None),
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -653,8 +654,15 @@ def build_parser() -> argparse.ArgumentParser:
         type=_str_list,
         metavar="MODE,...",
         help="orientation, environments: paper (one spot, default) and/or improved (the same "
-        "learning at every spot of a 1.5 m grid; heading from the best-fitting map), "
-        "e.g. --modes paper,improved",
+        "learning at every spot of a 1.5 m grid with exposure-normalised colours; heading "
+        "from the best-fitting map), e.g. --modes paper,improved",
+    )
+    p.add_argument(
+        "--light",
+        type=float,
+        metavar="L",
+        help="orientation, environments: room illumination for the views, in (0, 1] "
+        "(maps learned at full light; the paper's 5.3: 0.5)",
     )
     p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")

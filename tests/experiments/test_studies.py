@@ -158,6 +158,9 @@ def test_a_dead_worker_fails_its_jobs_clearly_not_the_run(homing_quick, tmp_path
         (["experiment", "homing", "--modes", "improved"], "does not take --modes"),
         (["experiment", "orientation", "--modes", "paper,better"], "unknown mode"),
         (["experiment", "orientation", "--modes", "paper,paper"], "distinct"),
+        (["experiment", "orientation", "--light", "1.5"], "light must be in"),
+        (["experiment", "environments", "--light", "0"], "light"),
+        (["experiment", "homing", "--light", "0.5"], "does not take --light"),
     ],
 )
 def test_bad_arguments_fail_before_any_work(tmp_path, capsys, argv, message):

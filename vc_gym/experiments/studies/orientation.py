@@ -12,8 +12,10 @@ estimates (fig. 4 left).
 Modes (:data:`VIEW_MODES`): ``paper`` is the paper's single spot; ``improved`` learns
 the same way at every spot of a grid over the field (:data:`GRID_SPACING_M` apart,
 :class:`~vc_gym.envs.learning.GridLearning`, shared colour classes, home the spot
-nearest the paper's), so that the trackers take the heading from the map that fits
-best (eq. 28), and distances are measured from the nearest spot.
+nearest the paper's) with exposure-normalised colour classes (so that it holds at half
+light), the trackers take the heading from the map that fits best (eq. 28), and
+distances are measured from the nearest spot. ``light`` dims the room for the views
+(the maps are learned at full light).
 
 :func:`view_job` and :func:`views_summary` are shared by the environments, parameter,
 illumination and tracker experiments.
@@ -53,6 +55,7 @@ from vc_gym.experiments.views import (
     spots_array,
     view_poses,
 )
+from vc_gym.validation import positive_float
 
 __all__ = [
     "DEFAULT_TRACKERS",
@@ -80,8 +83,9 @@ SIZES = {
 }
 
 
-#: How the heading is learned over the field, by name (``--modes``).
-VIEW_MODES = ("paper", "improved")
+#: How the heading is learned over the field, by name (``--modes``): the compass
+#: options of each mode (:class:`~vc_gym.compass.CompassConfig` fields).
+VIEW_MODES: dict[str, dict[str, Any]] = {"paper": {}, "improved": {"exposure": "mean"}}
 #: Spacing of the improved mode's grid of spots (metres) and its margin inside the field.
 GRID_SPACING_M = 1.5
 GRID_MARGIN_M = 0.5
@@ -339,6 +343,7 @@ def orientation_stage(
     """
     bounds = scene_field_bounds(scene)
     spots = training_spots(bounds, mode)
+    compass = {**VIEW_MODES[mode], **dict(compass or {})}
     if mode == "paper":
         spot: Any = spots[0]
         spec = atlas_spec(scene, opts.seed, "spot", size["learn_time_s"], compass, spot=spot)
@@ -360,6 +365,7 @@ def run_orientation(
     trackers: Sequence[Any] | None = None,
     scenes: Sequence[str] | None = None,
     modes: Sequence[str] | None = None,
+    light: float = 1.0,
 ) -> dict[str, Any]:
     """Run the orientation experiment (5.1, fig. 4) and write its results and plots.
 
@@ -377,13 +383,16 @@ def run_orientation(
     modes : sequence of str, optional
         :data:`VIEW_MODES` to run (default ``["paper"]``). With only ``paper`` the
         results hold ``scenes``; otherwise ``modes: {mode: {"scenes": ...}}``.
+    light : float
+        Illumination of the room for the views, in (0, 1]; the maps are learned at
+        full light (paper 5.3: half light).
 
     Returns
     -------
     dict
         The results written to ``results.json``.
     """
-    return _run_views("orientation", out_dir, opts, trackers, scenes or ["robolab"], modes)
+    return _run_views("orientation", out_dir, opts, trackers, scenes or ["robolab"], modes, light)
 
 
 def run_environments(
@@ -392,6 +401,7 @@ def run_environments(
     trackers: Sequence[Any] | None = None,
     scenes: Sequence[str] | None = None,
     modes: Sequence[str] | None = None,
+    light: float = 1.0,
 ) -> dict[str, Any]:
     """The orientation experiment in every registered scene (paper 5.3: other places).
 
@@ -401,7 +411,9 @@ def run_environments(
     """
     from vc_gym.envs.scenes import scene_names
 
-    return _run_views("environments", out_dir, opts, trackers, scenes or list(scene_names()), modes)
+    return _run_views(
+        "environments", out_dir, opts, trackers, scenes or list(scene_names()), modes, light
+    )
 
 
 def _check_modes(modes: Sequence[str] | None) -> list[str]:
@@ -414,15 +426,21 @@ def _check_modes(modes: Sequence[str] | None) -> list[str]:
     return list(modes)
 
 
-def _run_views(name, out_dir, opts, trackers, scenes, modes=None) -> dict[str, Any]:
+def _run_views(name, out_dir, opts, trackers, scenes, modes=None, light=1.0) -> dict[str, Any]:
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
     named = check_trackers(trackers or DEFAULT_TRACKERS)
     scenes = _check_scenes(scenes)
     modes = _check_modes(modes)
+    light = positive_float("light", light)
+    if light > 1.0:
+        raise ValueError(f"light must be in (0, 1], got {light}")
+    room = {"illumination": light} if light != 1.0 else None
     settings = {"trackers": named, "scenes": scenes, **size}
     if modes != ["paper"]:
         settings["modes"] = modes
+    if room:
+        settings["light"] = light
     run = open_run(out_dir, name, opts, settings)
     results: dict[str, Any] = {
         "paper": {"claim": "mean heading error < 10° within 2 m of the training spot"},
@@ -432,7 +450,7 @@ def _run_views(name, out_dir, opts, trackers, scenes, modes=None) -> dict[str, A
         per_scene = {}
         for scene in scenes:
             outputs, summary, spot, bounds = orientation_stage(
-                run, opts, size, scene, named, mode=mode
+                run, opts, size, scene, named, room=room, mode=mode
             )
             suffix = ("" if len(scenes) == 1 else f"_{scene}") + (
                 "" if mode == "paper" else f"_{mode}"
