@@ -1,8 +1,8 @@
 """The paper's scripted homing behaviour (section 5.2), acting on a tracker's estimates.
 
-:class:`ScriptedHomingPolicy` reads only what
-:class:`~vc_gym.envs.CompassObservation` adds to the observation (the estimated home
-vector and heading spread): it never sees the true pose. The learning phase that comes
+:class:`ScriptedHomingPolicy` reads only the robot's own observation: what
+:class:`~vc_gym.envs.CompassObservation` adds (the estimated home vector, heading and
+heading spread) and the odometry; it never sees the true pose. The learning phase that comes
 before homing belongs to the task (:mod:`vc_gym.envs.learning`).
 """
 
@@ -27,7 +27,8 @@ class ScriptedHomingPolicy:
     spread is below ``max_spread_deg``, so the filters settle; then turn towards the
     estimated home and walk (slower when close); stand still, scanning with the head,
     once the estimate is within ``home_tolerance_m`` of home. Uses only
-    ``home_vector`` and ``heading_spread`` of the observation.
+    ``home_vector`` and ``heading_spread`` of the observation, and with
+    ``verify_home`` also ``heading`` and ``odometry``.
 
     Parameters
     ----------
