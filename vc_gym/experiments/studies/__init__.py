@@ -55,7 +55,8 @@ EXPERIMENTS: dict[str, Experiment] = {
             _P + "orientation",
             "5.1, fig. 4: learn one spot (centre of the rear field half), heading error and "
             "spread of every tracker over a grid of poses vs distance from the spot, and "
-            "the arrow field of the estimates",
+            "the arrow field of the estimates (--modes paper,improved: also maps on a "
+            "1.5 m grid of spots; --light: dimmer views)",
         ),
         Experiment(
             "environments",
@@ -84,8 +85,9 @@ EXPERIMENTS: dict[str, Experiment] = {
             "localization",
             _P + "localization",
             "beyond the paper (5.2's open problem): maps on a grid of spots, position "
-            "error over the whole field of eq. 30 and of a likelihood calibrated on "
-            "goodness against distance",
+            "error over the whole field from one view (eq. 30; a likelihood calibrated on "
+            "goodness against distance) and from a full turn (the same; nearest goodness "
+            "signatures)",
         ),
         Experiment(
             "paper",
