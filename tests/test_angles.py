@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from vc_gym.angles import circular_mean, circular_std, wrap180, wrap360
+from vc_gym.angles import circular_mean, circular_std, circular_std_rows, wrap180, wrap360
 
 angles = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False)
 
@@ -52,3 +52,26 @@ def test_weights_validation():
         circular_mean([1.0, 2.0], weights=[-1.0, 2.0])
     with pytest.raises(ValueError):
         circular_mean([])
+
+
+def test_circular_std_rows_equals_circular_std_on_every_row():
+    rng = np.random.default_rng(3)
+    angles = np.arange(0.0, 360.0, 1.0)
+    weights = np.exp(-0.5 * ((angles[None, :] - rng.uniform(0, 360, (5, 1))) / 4.0) ** 2)
+    weights[2] = 1.0  # uniform: no concentration
+    weights[3, :] = 0.0
+    weights[3, 90] = 1.0  # one heading: spread 0
+    rows = circular_std_rows(angles, weights)
+    assert rows.shape == (5,)
+    for row, w in zip(rows, weights, strict=True):
+        assert row == circular_std(angles, w)
+    assert rows[3] == 0.0 and rows[2] > 180.0
+
+
+@pytest.mark.parametrize(
+    "weights",
+    [np.ones(4), np.ones((2, 3)), np.full((2, 4), np.nan), -np.ones((2, 4)), np.zeros((2, 4))],
+)
+def test_circular_std_rows_rejects_bad_weights(weights):
+    with pytest.raises(ValueError, match="weights"):
+        circular_std_rows([0.0, 90.0, 180.0, 270.0], weights)

@@ -12,7 +12,14 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["wrap180", "wrap360", "circular_mean", "circular_std", "interp_circular"]
+__all__ = [
+    "wrap180",
+    "wrap360",
+    "circular_mean",
+    "circular_std",
+    "circular_std_rows",
+    "interp_circular",
+]
 
 
 def wrap180(angle_deg: ArrayLike) -> np.ndarray | float:
@@ -79,7 +86,30 @@ def circular_std(angle_deg: ArrayLike, weights: ArrayLike | None = None) -> floa
         raise ValueError("circular_std needs at least one angle")
     w = _weights(a, weights)
     r = np.hypot(np.sum(w * np.sin(a)), np.sum(w * np.cos(a))) / np.sum(w)
-    r = min(float(r), 1.0)
+    return _std_from_resultant(float(r))
+
+
+def circular_std_rows(angle_deg: ArrayLike, weights: ArrayLike) -> np.ndarray:
+    """:func:`circular_std` of each row of ``weights`` over the same angles, at once.
+
+    ``angle_deg`` is ``(N,)`` and ``weights`` ``(M, N)``; the result ``(M,)`` equals
+    calling :func:`circular_std` on every row, bit for bit.
+    """
+    a = np.radians(np.asarray(angle_deg, dtype=float))
+    w = np.asarray(weights, dtype=float)
+    if a.ndim != 1 or a.size == 0 or w.ndim != 2 or w.shape[1] != a.size:
+        raise ValueError(
+            f"circular_std_rows needs (N,) angles and (M, N) weights, got {a.shape} and {w.shape}"
+        )
+    if not np.all(np.isfinite(w)) or np.any(w < 0) or np.any(w.sum(axis=1) <= 0):
+        raise ValueError("weights must be finite, non-negative and not all zero in a row")
+    r = np.hypot((w * np.sin(a)).sum(axis=1), (w * np.cos(a)).sum(axis=1)) / w.sum(axis=1)
+    return np.array([_std_from_resultant(float(v)) for v in r])
+
+
+def _std_from_resultant(r: float) -> float:
+    """``sqrt(-2 ln R)`` in degrees (infinite for ``R = 0``; ``R`` capped at 1)."""
+    r = min(r, 1.0)
     if r <= 0.0:
         return float("inf")
     return float(np.degrees(np.sqrt(max(-2.0 * math.log(r), 0.0))))

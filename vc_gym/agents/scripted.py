@@ -201,13 +201,12 @@ class ScriptedHomingPolicy:
                 self._offsets.append(body_to_world(*map(float, obs["home_vector"]), heading))
             if self._turned_deg < 360.0:
                 return self.velocity_action(turn_deg_s=self.verify_turn_deg_s, pan_deg=0.0)
+            # the turn is complete only after an observation, so ``heading`` is this one's
             dx, dy = (float(v) for v in np.mean(self._offsets, axis=0))
             self.checks.append((dx, dy))
             if math.hypot(dx, dy) <= self.verify_tolerance_m:
                 self.phase = "done"
             else:
-                c, s = (float(v) for v in obs["heading"])
-                heading = math.degrees(math.atan2(s, c))
                 g = self.verify_gain
                 self._target = world_to_body(g * dx, g * dy, heading)
                 self.phase = "correct"

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vc_gym.angles import wrap360
+from vc_gym.angles import circular_std_rows, wrap360
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
@@ -442,16 +442,10 @@ class VisualCompass:
         return self._estimate_of(*self._sector_features(image, camera))
 
     def _estimate_of(
-        self,
-        geom: _Geometry,
-        counts: np.ndarray,
-        total: np.ndarray,
-        ll: np.ndarray | None = None,
+        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
     ) -> CompassEstimate:
-        """:meth:`estimate` from sector features (shared by compasses with one colour set)
-        and, when already computed, the log-likelihood over headings."""
-        if ll is None:
-            ll = self._log_likelihood_of(geom, counts, total)
+        """:meth:`estimate` from sector features."""
+        ll = self._log_likelihood_of(geom, counts, total)
         return estimates_of([self], geom, counts, total, ll[None])[0]
 
     # ------------------------------------------------------------------ persistence
@@ -657,12 +651,7 @@ def estimates_of(
     frac[peaked] = 0.5 * (y0[peaked] - y2[peaked]) / denom[peaked]
     step = first.config.heading_step_deg
     heading = wrap360(headings[best] + np.clip(frac, -0.5, 0.5) * step)
-    post = np.exp(lls - y1[:, None])
-    a = np.radians(headings)
-    r = np.hypot((post * np.sin(a)).sum(axis=1), (post * np.cos(a)).sum(axis=1))
-    r = np.minimum(r / post.sum(axis=1), 1.0)
-    with np.errstate(divide="ignore"):
-        spread = np.where(r > 0.0, np.degrees(np.sqrt(np.maximum(-2.0 * np.log(r), 0.0))), np.inf)
+    spread = circular_std_rows(headings, np.exp(lls - y1[:, None]))
     scores, n_sectors = _scores_at(compasses, geom, counts, total, best)
     return [
         CompassEstimate(float(heading[k]), float(spread[k]), scores[k], n_sectors[k], lls[k])

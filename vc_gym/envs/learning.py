@@ -270,6 +270,8 @@ class ScriptedLearner:
         RobotFell
             If the robot falls (only with ``locomotion="dynamic"``).
         """
+        if colors is not None and not isinstance(colors, ColorClasses):
+            raise ValueError(f"colors must be ColorClasses, got {type(colors).__name__}")
         if steps is None:
             steps = self._steps_per_direction()
         elif isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
@@ -279,8 +281,6 @@ class ScriptedLearner:
         self.home_compass = None
         self.rot_scale = 1.0
         self._scan_i = 0
-        if colors is not None and not isinstance(colors, ColorClasses):
-            raise ValueError(f"colors must be ColorClasses, got {type(colors).__name__}")
         self._learn_home(int(steps), colors)
         return self.home_compass
 

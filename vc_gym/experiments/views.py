@@ -127,16 +127,18 @@ def _frames(frames: object) -> list[Frame]:
 
 
 def _spot(spot: object) -> tuple[float, float]:
-    try:
-        x, y = spot  # type: ignore[misc]
-    except (TypeError, ValueError):
-        raise ValueError(f"spot must be (x, y), got {spot!r}") from None
-    return finite_float("spot x", x), finite_float("spot y", y)
+    spots = spots_array(spot)
+    if len(spots) != 1:
+        raise ValueError(f"spot must be (x, y), got {spot!r}")
+    return float(spots[0, 0]), float(spots[0, 1])
 
 
 def spots_array(spot: object) -> np.ndarray:
     """One spot ``(x, y)`` or several ``[(x, y), ...]`` as a finite ``(N, 2)`` array."""
-    a = np.asarray(spot, dtype=np.float64) if not isinstance(spot, str) else np.zeros(0)
+    try:
+        a = np.asarray(spot, dtype=np.float64)
+    except (TypeError, ValueError):
+        a = np.zeros(0)
     if a.shape == (2,):
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != 2 or len(a) == 0 or not np.all(np.isfinite(a)):

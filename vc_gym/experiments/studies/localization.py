@@ -228,9 +228,11 @@ def calibration_points(spots: np.ndarray, bounds: Sequence[float] | None = None)
         for j in range(i + 1, len(pts))
         if d[i, j] <= 1.01 * max(nearest[i], nearest[j])
     ]
-    out = np.vstack([pts, *mids]) if mids else pts
-    extra = [p for p in border if not np.any(np.all(np.abs(out - p) < 1e-6, axis=1))]
-    return np.vstack([out, *extra]) if extra else out
+    out = list(np.vstack([pts, *mids]) if mids else pts)
+    for p in border:  # each border point once, and none that is already a place
+        if not np.any(np.all(np.abs(np.asarray(out) - p) < 1e-6, axis=1)):
+            out.append(p)
+    return np.array(out, np.float64)
 
 
 def _border_points(pts: np.ndarray, bounds: Sequence[float]) -> np.ndarray:
@@ -247,11 +249,7 @@ def _border_points(pts: np.ndarray, bounds: Sequence[float]) -> np.ndarray:
         out += [(x, lo_y)] if col.min() > lo_y + 1e-6 else []
         out += [(x, hi_y)] if col.max() < hi_y - 1e-6 else []
     out += [(lo_x, lo_y), (lo_x, hi_y), (hi_x, lo_y), (hi_x, hi_y)]
-    seen: list[tuple[float, float]] = []
-    for p in out:
-        if all(abs(p[0] - q[0]) > 1e-6 or abs(p[1] - q[1]) > 1e-6 for q in seen):
-            seen.append(p)
-    return np.array(seen, np.float64)
+    return np.array(out, np.float64)
 
 
 def locate_job(

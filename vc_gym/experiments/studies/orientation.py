@@ -61,6 +61,7 @@ __all__ = [
     "DEFAULT_TRACKERS",
     "VIEW_MODES",
     "training_spots",
+    "views_stage",
     "HEADLINE",
     "headline_errors",
     "one_scene",
@@ -354,8 +355,7 @@ def orientation_stage(
     jobs = view_jobs(
         "pos-", scene, atlas_path, spot, bounds, size, opts.seed, trackers, room, time_learning
     )
-    default_stage = f"views-{scene}" if mode == "paper" else f"views-{mode}-{scene}"
-    outputs = run.run(stage or default_stage, jobs)
+    outputs = run.run(stage or views_stage(mode, scene), jobs)
     return outputs, views_summary(outputs, list(trackers)), spot, bounds
 
 
@@ -426,6 +426,11 @@ def _check_modes(modes: Sequence[str] | None) -> list[str]:
     return list(modes)
 
 
+def views_stage(mode: str, scene: str) -> str:
+    """Name of the stage that runs ``mode``'s view jobs in ``scene``."""
+    return f"views-{scene}" if mode == "paper" else f"views-{mode}-{scene}"
+
+
 def _run_views(name, out_dir, opts, trackers, scenes, modes=None, light=1.0) -> dict[str, Any]:
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
@@ -466,7 +471,7 @@ def _run_views(name, out_dir, opts, trackers, scenes, modes=None, light=1.0) -> 
         results["scenes"] = per_mode["paper"]
     else:
         results["modes"] = {m: {"scenes": per_mode[m]} for m in modes}
-    return run.finish(results, _cost_info(run, modes))
+    return run.finish(results, _cost_info(run, modes, scenes))
 
 
 def _plot_scenes(path: Path, per_scene: Mapping[str, Any], tracker: str = "grid") -> None:
@@ -503,27 +508,19 @@ def _check_scenes(scenes: Sequence[str]) -> list[str]:
     return out
 
 
-def _cost_info(run: ExperimentRun, modes: Sequence[str] = ("paper",)) -> dict[str, Any]:
+def _cost_info(run: ExperimentRun, modes: Sequence[str], scenes: Sequence[str]) -> dict[str, Any]:
     """Median ms per update of every tracker over the view jobs, overall and per mode
     (for ``run.json``; :func:`cost_lines` prints them)."""
 
-    def stage_mode(stage: str) -> str:
-        parts = stage.split("-")
-        return parts[1] if len(parts) > 2 and parts[1] in VIEW_MODES else "paper"
+    def timings(mode: str) -> list[Any]:
+        stages = [run.timings.get(views_stage(mode, scene), {}) for scene in scenes]
+        return [t for jobs in stages for t in jobs.values()]
 
-    views = {
-        stage: list(jobs.values())
-        for stage, jobs in run.timings.items()
-        if stage.startswith("views")
-    }
     info: dict[str, Any] = {
-        "ms_per_update_median": median_timings([t for ts in views.values() for t in ts])
+        "ms_per_update_median": median_timings([t for m in modes for t in timings(m)])
     }
     if list(modes) != ["paper"]:
-        info["ms_per_update_median_by_mode"] = {
-            m: median_timings([t for st, ts in views.items() if stage_mode(st) == m for t in ts])
-            for m in modes
-        }
+        info["ms_per_update_median_by_mode"] = {m: median_timings(timings(m)) for m in modes}
     return info
 
 
