@@ -107,6 +107,8 @@ def test_eq30_picks_the_best_spot_when_sharp():
         lambda: calibrate(SPOTS, SPOTS, np.zeros((len(SPOTS), 2))),
         lambda: calibrate(SPOTS[:, :1], SPOTS, np.zeros((len(SPOTS), len(SPOTS)))),
         lambda: locate_calibrated(np.zeros(2), SPOTS, None, BOUNDS),
+        lambda: calibration_points(SPOTS, (0.0, 1.0)),
+        lambda: calibration_points(np.full((2, 2), np.nan)),
     ],
 )
 def test_bad_inputs_are_clear_errors(call):
@@ -136,3 +138,8 @@ def test_more_than_one_scene_is_refused(tmp_path, capsys):
 @pytest.mark.parametrize("n", [1])
 def test_a_single_spot_has_no_midpoints(n):
     assert len(calibration_points(SPOTS[:n])) == n
+
+
+def test_border_places_need_ordered_bounds():
+    with pytest.raises(ValueError, match="min < max"):
+        calibration_points(SPOTS, (3.0, -3.0, -2.0, 2.0))

@@ -21,8 +21,8 @@ from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.visual_compass import (
     CompassEstimate,
     VisualCompass,
-    estimates_of,
-    log_likelihoods_of,
+    _estimates_of,
+    _log_likelihoods_of,
 )
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
@@ -151,8 +151,8 @@ class CompassAtlas:
                 vc._checked(image, camera, need_map=True)
             features = first._sector_features(image, camera)
             delta_t, base = self._stacked_tables()
-            lls = log_likelihoods_of(first.config, *features, delta_t, base)
-            ests = estimates_of(self.compasses, *features, lls)
+            lls = _log_likelihoods_of(first.config, *features, delta_t, base)
+            ests = _estimates_of(self.compasses, *features, lls)
         else:
             ests = [vc.estimate(image, camera) for vc in self.compasses]
         return np.array([e.score for e in ests]), ests

@@ -429,7 +429,7 @@ class VisualCompass:
     ) -> np.ndarray:
         """Log-likelihood over headings from sector features (see log_likelihood)."""
         delta_t, base, _ = self._log_tables()
-        return log_likelihoods_of(
+        return _log_likelihoods_of(
             self.config, geom, counts, total, delta_t[:, None, :], base[None]
         )[0]
 
@@ -446,7 +446,7 @@ class VisualCompass:
     ) -> CompassEstimate:
         """:meth:`estimate` from sector features."""
         ll = self._log_likelihood_of(geom, counts, total)
-        return estimates_of([self], geom, counts, total, ll[None])[0]
+        return _estimates_of([self], geom, counts, total, ll[None])[0]
 
     # ------------------------------------------------------------------ persistence
     def save(self, path: str | os.PathLike) -> Path:
@@ -582,7 +582,7 @@ class VisualCompass:
         )
 
 
-def log_likelihoods_of(
+def _log_likelihoods_of(
     config: CompassConfig,
     geom: _Geometry,
     counts: np.ndarray,
@@ -624,7 +624,7 @@ def log_likelihoods_of(
     return np.ascontiguousarray(ll)
 
 
-def estimates_of(
+def _estimates_of(
     compasses: Sequence[VisualCompass],
     geom: _Geometry,
     counts: np.ndarray,
@@ -633,7 +633,7 @@ def estimates_of(
 ) -> list[CompassEstimate]:
     """:class:`CompassEstimate` of one frame under each map, from its log-likelihoods.
 
-    ``lls`` is ``(M, n_headings)`` (:func:`log_likelihoods_of`). The best heading is
+    ``lls`` is ``(M, n_headings)`` (:func:`_log_likelihoods_of`). The best heading is
     refined by a parabola through the peak and its neighbours, the spread is the
     circular standard deviation of the posterior (eq. 27) and the score the mean
     per-term log-probability at the best heading (eq. 28), all computed for the ``M``

@@ -218,7 +218,7 @@ def calibration_points(spots: np.ndarray, bounds: Sequence[float] | None = None)
     column moved out to :data:`BORDER_MARGIN_M` inside the field's edge (and the four
     corners), so that calibration also covers the strip beyond the outer spots.
     """
-    pts = np.asarray(spots, np.float64)
+    pts = _array("spots", spots, (None, 2))
     border = _border_points(pts, bounds) if bounds is not None else np.zeros((0, 2))
     d = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
     nearest = np.min(np.where(d > 0, d, np.inf), axis=1)
@@ -236,7 +236,9 @@ def calibration_points(spots: np.ndarray, bounds: Sequence[float] | None = None)
 
 
 def _border_points(pts: np.ndarray, bounds: Sequence[float]) -> np.ndarray:
-    x0, x1, y0, y1 = (float(v) for v in bounds)
+    x0, x1, y0, y1 = _array("bounds", bounds, (4,))
+    if not (x0 < x1 and y0 < y1):
+        raise ValueError(f"bounds must be (xmin, xmax, ymin, ymax) with min < max, got {bounds}")
     m = BORDER_MARGIN_M
     lo_x, hi_x, lo_y, hi_y = x0 + m, x1 - m, y0 + m, y1 - m
     out = []
