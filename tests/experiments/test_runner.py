@@ -124,6 +124,44 @@ def test_a_dead_worker_fails_its_job_not_the_run(tmp_path):
     assert "worker process died" in failure["error"]
 
 
+class PoolThatBreaks:
+    """A process pool whose worker died just before the next submission: it runs the
+    first ``good`` jobs, then refuses every new one (as a broken ProcessPoolExecutor
+    does) and fails those still pending."""
+
+    def __init__(self, good):
+        import concurrent.futures as cf
+
+        self.cf, self.good, self.futures = cf, good, []
+
+    def submit(self, fn, *args):
+        from concurrent.futures.process import BrokenProcessPool
+
+        if self.good == 0:
+            for f in self.futures:
+                if not f.done():
+                    f.set_exception(BrokenProcessPool("a worker died"))
+            raise BrokenProcessPool("a worker died")
+        self.good -= 1
+        fut = self.cf.Future()
+        fut.set_result(fn(*args))
+        self.futures.append(fut)
+        return fut
+
+    def shutdown(self, wait=True, cancel_futures=False):
+        pass
+
+
+@pytest.mark.parametrize("good", [0, 1, 3])
+def test_a_pool_that_breaks_between_submissions_loses_no_job(tmp_path, good):
+    with LocalBackend(2) as backend:
+        backend._executor = PoolThatBreaks(good)  # the next pool is a fresh, real one
+        run = ExperimentRun(tmp_path, "toy", backend, {}, progress=False)
+        outs = run.run("squares", square_jobs(5))
+    assert [o["square"] for o in outs] == [0, 1, 4, 9, 16]
+    assert run.failures == []
+
+
 def test_a_folder_of_another_run_is_refused(tmp_path):
     run_squares(tmp_path, 1, n=2)
     with pytest.raises(ValueError, match="another run"):

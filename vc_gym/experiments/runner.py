@@ -244,6 +244,11 @@ class LocalBackend:
             self._executor.shutdown(wait=True, cancel_futures=True)
             self._executor = None
 
+    def _discard_pool(self) -> None:
+        """Drop a broken pool; the next :meth:`_pool` starts fresh workers."""
+        self._executor.shutdown(wait=False, cancel_futures=True)
+        self._executor = None
+
     def _pool_run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
         queue = list(range(len(jobs)))[::-1]
         # Jobs that were running when a worker died: the pool cannot say whose worker
@@ -254,13 +259,24 @@ class LocalBackend:
         running: dict[cf.Future, int] = {}
         while queue or running or suspects:
             pool = self._pool()
+            # a worker can die between two submissions: the pool then refuses new jobs,
+            # which go back where they came from (they never ran)
+            refused = False
             if not running and suspects:
                 isolating = suspects.pop()
-                running[pool.submit(_execute, *_call(jobs[isolating]))] = isolating
+                if not _submit(pool, running, jobs, isolating):
+                    suspects.append(isolating)
+                    isolating, refused = None, True
             elif isolating is None:
                 while queue and len(running) < self.workers:
                     i = queue.pop()
-                    running[pool.submit(_execute, *_call(jobs[i]))] = i
+                    if not _submit(pool, running, jobs, i):
+                        queue.append(i)
+                        refused = True
+                        break
+            if refused and not running:
+                self._discard_pool()
+                continue
             done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
             alone = len(running) == 1
             broken: list[int] = []
@@ -277,8 +293,7 @@ class LocalBackend:
             if broken:
                 broken += list(running.values())  # they died with the pool
                 running.clear()
-                self._executor.shutdown(wait=False, cancel_futures=True)
-                self._executor = None
+                self._discard_pool()
                 isolating = None
                 if alone:
                     yield broken[0], False, {"error": _DIED, "traceback": _DIED}, math.nan
@@ -294,6 +309,17 @@ _DIED = (
 
 def _call(job: Job) -> tuple[str, Mapping[str, Any]]:
     return job.fn, job.kwargs
+
+
+def _submit(
+    pool: cf.ProcessPoolExecutor, running: dict[cf.Future, int], jobs: Sequence[Job], i: int
+) -> bool:
+    """Submit job ``i`` to ``pool`` (recorded in ``running``); False if the pool is broken."""
+    try:
+        running[pool.submit(_execute, *_call(jobs[i]))] = i
+    except BrokenProcessPool:
+        return False
+    return True
 
 
 def _noop(_: int) -> None:
