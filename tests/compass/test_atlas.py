@@ -114,3 +114,31 @@ def test_all_spots_at_once_equal_each_compass_on_its_own(atlas, room, pose):
     second = grown.scores(image, Camera())[0]
     assert first[0] == second[0] == before[0] and first[1] != second[1]
     assert second[1] == extra.estimate(image, Camera()).score
+
+
+def test_a_subset_of_spots_equals_their_part_of_the_full_answer(atlas, room):
+    image = render_room_view(room, 0.4, -0.3, Camera(yaw_deg=120.0))
+    raw, full = atlas.scores(image, Camera())
+    some = [2, 0]
+    part_raw, part = atlas.scores(image, Camera(), spots=some)
+    np.testing.assert_array_equal(part_raw, raw[some])
+    for k, est in zip(some, part, strict=True):
+        np.testing.assert_array_equal(est.log_likelihood, full[k].log_likelihood)
+        assert est.heading_deg == full[k].heading_deg
+    est = atlas.estimate_position(image, Camera(), spots=some)
+    names = [atlas.names[k] for k in some]
+    assert list(est.goodness) == list(est.weights) == list(est.estimates) == names
+    assert sum(est.weights.values()) == pytest.approx(1.0)
+    # eq. 30 over the subset: a weighted mean of those spots only
+    expected = sum(est.weights[n] * atlas.positions[atlas.names.index(n)] for n in names)
+    assert est.position == pytest.approx(tuple(expected))
+    everything = atlas.estimate_position(image, Camera())
+    whole = atlas.estimate_position(image, Camera(), spots=range(len(atlas)))
+    assert whole.position == everything.position and whole.goodness == everything.goodness
+
+
+@pytest.mark.parametrize("spots", [[], [0, 0], [-1], [99], [0.5], "ab", [[0, 1]]])
+def test_bad_spot_subsets_are_refused(atlas, room, spots):
+    image = render_room_view(room, 0.0, 0.0, Camera())
+    with pytest.raises(ValueError, match="spots"):
+        atlas.estimate_position(image, Camera(), spots=spots)

@@ -205,3 +205,21 @@ def test_orientation_in_both_modes(tmp_path, capsys):
     assert (out / "error_vs_distance_improved.png").is_file()
     text = capsys.readouterr().out
     assert "improved mode:" in text and "12 spots" in text
+
+
+def test_the_improved_mode_gives_the_built_in_trackers_a_shortlist():
+    from vc_gym.experiments.studies.orientation import MODE_TRACKER_OPTIONS, mode_trackers
+
+    trackers = {
+        "grid": "grid",
+        "k": {"type": "kalman", "gate_sigma": 2.0},
+        "mine": {"type": "particle", "shortlist": 5},
+        "user": "my_package.trackers:make",
+    }
+    assert mode_trackers(trackers, "paper") == trackers
+    improved = mode_trackers(trackers, "improved")
+    options = MODE_TRACKER_OPTIONS["improved"]
+    assert improved["grid"] == {"type": "grid", **options}
+    assert improved["k"] == {"type": "kalman", "gate_sigma": 2.0, **options}
+    assert improved["mine"]["shortlist"] == 5  # set explicitly: kept
+    assert improved["user"] == "my_package.trackers:make"

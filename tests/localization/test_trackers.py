@@ -90,6 +90,27 @@ def test_grid_tracker_is_the_papers_two_filters(room_atlas, frames):
         np.testing.assert_array_equal(state.belief, hf.belief)
 
 
+@pytest.mark.parametrize("name", sorted(TRACKERS))
+def test_a_shortlist_scores_the_best_spots_between_full_scorings(name, room_atlas, frames):
+    everything = run(make_tracker(name), room_atlas, frames)
+    same = run(make_tracker({"type": name, "shortlist": len(room_atlas)}), room_atlas, frames)
+    assert [s.heading_deg for s in same] == [s.heading_deg for s in everything]
+    assert [s.position for s in same] == [s.position for s in everything]
+    states = run(
+        make_tracker({"type": name, "shortlist": 2, "rescore_every": 3}), room_atlas, frames
+    )
+    for k, state in enumerate(states):
+        scored = np.flatnonzero(state.goodness > 0)
+        if k % 3 == 0:  # a full scoring: every spot, the same goodness as without a shortlist
+            np.testing.assert_array_equal(scored, np.arange(len(room_atlas)))
+            best = set(np.argsort(-state.goodness)[:2])
+        else:
+            assert set(scored) == best
+    _, _, true = frames[-1]
+    assert abs(wrap180(states[-1].heading_deg - true[2])) < 10.0
+    assert math.hypot(states[-1].position[0] - true[0], states[-1].position[1] - true[1]) < 0.6
+
+
 def test_particle_tracker_is_reproducible_and_recovers(room_atlas, frames):
     a = run(ParticleTracker(n_particles=500, seed=3), room_atlas, frames)
     b = run(ParticleTracker(n_particles=500, seed=3), room_atlas, frames)
@@ -145,6 +166,9 @@ def test_bad_use_is_a_clear_error(name, room_atlas, frames):
         (GridTracker, {"half_life_s": 0.0}),
         (GridTracker, {"rule": "vote"}),
         (GridTracker, {"turn_noise": -1.0}),
+        (GridTracker, {"shortlist": 0}),
+        (KalmanTracker, {"shortlist": 1.5}),
+        (ParticleTracker, {"rescore_every": True}),
         (KalmanTracker, {"gate_sigma": float("nan")}),
         (KalmanTracker, {"max_rejections": 0}),
         (KalmanTracker, {"heading_temperature": "hot"}),

@@ -45,8 +45,9 @@ class AtlasEstimate:
     position : tuple of float
         Likelihood-weighted mean of the spot positions (eq. 30), world ``(x, y)``.
     goodness : dict
-        Normalised goodness ``L̂_i`` per spot name (1.0 for every spot at home after
-        :meth:`CompassAtlas.normalize`; larger means the image fits that spot better).
+        Normalised goodness ``L̂_i`` per spot name, for the spots scored (1.0 for every
+        spot at home after :meth:`CompassAtlas.normalize`; larger means the image fits
+        that spot better).
     weights : dict
         The weights of eq. 30 per spot (sum to 1).
     estimates : dict
@@ -141,21 +142,48 @@ class CompassAtlas:
     def __len__(self) -> int:
         return len(self.names)
 
-    def scores(self, image: np.ndarray, camera: Camera) -> tuple[np.ndarray, list[CompassEstimate]]:
-        """Raw per-spot scores (mean log-probability per term) and estimates."""
-        first = self.compasses[0]
+    def scores(
+        self, image: np.ndarray, camera: Camera, spots: Sequence[int] | None = None
+    ) -> tuple[np.ndarray, list[CompassEstimate]]:
+        """Raw per-spot scores (mean log-probability per term) and estimates.
+
+        ``spots`` (indices into :attr:`names`) scores only those spots' maps, in that
+        order; each equals its entry of the full answer bit for bit.
+        """
+        which = self._spot_indices(spots)
+        compasses = [self.compasses[k] for k in which]
+        first = compasses[0]
         if all(vc.colors is first.colors for vc in self.compasses):
             # one colour set and config (the usual case): the image's sector features
             # are the same for every spot, so compute them once
-            for vc in self.compasses:
+            for vc in compasses:
                 vc._checked(image, camera, need_map=True)
             features = first._sector_features(image, camera)
             delta_t, base = self._stacked_tables()
-            lls = _log_likelihoods_of(first.config, *features, delta_t, base)
-            ests = _estimates_of(self.compasses, *features, lls)
+            maps = None if spots is None else which
+            lls = _log_likelihoods_of(first.config, *features, delta_t, base, maps)
+            ests = _estimates_of(compasses, *features, lls)
         else:
-            ests = [vc.estimate(image, camera) for vc in self.compasses]
+            ests = [vc.estimate(image, camera) for vc in compasses]
         return np.array([e.score for e in ests]), ests
+
+    def _spot_indices(self, spots: Sequence[int] | None) -> np.ndarray:
+        """``spots`` checked: distinct in-range indices (every spot when ``None``)."""
+        if spots is None:
+            return np.arange(len(self.names))
+        try:
+            which = np.asarray(spots)
+            ok = which.ndim == 1 and which.size > 0 and np.issubdtype(which.dtype, np.integer)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or which.min() < 0 or which.max() >= len(self.names):
+            raise ValueError(
+                f"spots must be a non-empty sequence of spot indices in [0, {len(self.names)}),"
+                f" got {spots!r}"
+            )
+        if np.unique(which).size != which.size:
+            raise ValueError(f"spots must not repeat an index, got {spots!r}")
+        return which.astype(np.intp)
 
     def _stacked_tables(self) -> tuple[np.ndarray, np.ndarray]:
         """Every map's log tables stacked (``(c²·n, M, S)``, ``(M, S)``), rebuilt only
@@ -217,37 +245,51 @@ class CompassAtlas:
         self.is_normalized = True
         return self._home_scores.mean(axis=0)
 
-    def home_scores(self, headings_deg: np.ndarray) -> np.ndarray:
-        """Home score of each spot at the given per-spot headings (0 before normalize)."""
+    def home_scores(
+        self, headings_deg: np.ndarray, spots: Sequence[int] | None = None
+    ) -> np.ndarray:
+        """Home score of each spot at the given per-spot headings (0 before normalize);
+        ``spots`` as in :meth:`scores`."""
+        which = self._spot_indices(spots)
         if not self.is_normalized:
-            return np.zeros(len(self.names))
-        d = np.radians(np.asarray(headings_deg)[None, :] - self._home_headings)
+            return np.zeros(which.size)
+        home_headings = self._home_headings[:, which]
+        d = np.radians(np.asarray(headings_deg)[None, :] - home_headings)
         w = np.exp(self._kappa * (np.cos(d) - 1.0))  # (frames, spots)
-        return (w * self._home_scores).sum(axis=0) / w.sum(axis=0)
+        return (w * self._home_scores[:, which]).sum(axis=0) / w.sum(axis=0)
 
-    def estimate_position(self, image: np.ndarray, camera: Camera) -> AtlasEstimate:
+    def estimate_position(
+        self, image: np.ndarray, camera: Camera, spots: Sequence[int] | None = None
+    ) -> AtlasEstimate:
         """Position from the goodness of every spot (eq. 28-30).
 
         ``L̂_i = exp(score_i - home_score_i)`` (home score at spot ``i``'s heading
         estimate, see :meth:`normalize`), weights ``∝ L̂_i ** sharpness``, position
         ``= Σ w_i T_i``. Before :meth:`normalize` the home scores are zero.
+
+        ``spots`` (indices into :attr:`names`) limits eq. 28-30 to those spots: only
+        their maps are read (the cost grows with their number), and the estimate's
+        dictionaries hold only them (a tracker can score only the few spots that fitted
+        best a moment ago).
         """
         if any(not vc.is_learned for vc in self.compasses):
             missing = [
                 n for n, vc in zip(self.names, self.compasses, strict=True) if not vc.is_learned
             ]
             raise NotLearnedError(f"spots without a learned map: {missing}")
-        raw, ests = self.scores(image, camera)
-        rel = raw - self.home_scores(np.array([e.heading_deg for e in ests]))
+        which = self._spot_indices(spots)
+        raw, ests = self.scores(image, camera, spots)
+        rel = raw - self.home_scores(np.array([e.heading_deg for e in ests]), spots)
         logw = self.sharpness * rel
         w = np.exp(logw - logw.max())
         w /= w.sum()
-        pos = w @ self.positions
+        pos = w @ self.positions[which]
+        names = [self.names[k] for k in which]
         return AtlasEstimate(
             position=(float(pos[0]), float(pos[1])),
-            goodness={n: float(math.exp(r)) for n, r in zip(self.names, rel, strict=True)},
-            weights={n: float(v) for n, v in zip(self.names, w, strict=True)},
-            estimates=dict(zip(self.names, ests, strict=True)),
+            goodness={n: float(math.exp(r)) for n, r in zip(names, rel, strict=True)},
+            weights={n: float(v) for n, v in zip(names, w, strict=True)},
+            estimates=dict(zip(names, ests, strict=True)),
         )
 
     # ------------------------------------------------------------------ persistence

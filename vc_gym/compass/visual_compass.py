@@ -589,6 +589,7 @@ def _log_likelihoods_of(
     total: np.ndarray,
     delta_t: np.ndarray,
     base: np.ndarray,
+    maps: np.ndarray | None = None,
 ) -> np.ndarray:
     """Log-likelihood over headings (eq. 5, 15-16) of one frame under several maps.
 
@@ -597,10 +598,13 @@ def _log_likelihoods_of(
     ``delta_t`` ``(c²·n, M, S)`` and ``base`` ``(M, S)`` are the maps' stacked log
     tables (:meth:`VisualCompass._log_tables`; rows first, so that one read brings a
     row of every map). Sums run in the same order for any ``M``, so each map's row
-    equals its own :meth:`VisualCompass.log_likelihood` bit for bit. Returns
-    ``(M, n_headings)``; all zeros where nothing was seen.
+    equals its own :meth:`VisualCompass.log_likelihood` bit for bit. ``maps`` (indices
+    into ``M``) scores only those maps, reading only their tables. Returns
+    ``(M, n_headings)`` (``(len(maps), n_headings)``); all zeros where nothing was seen.
     """
-    m = delta_t.shape[1]
+    if maps is not None:
+        base = base[maps]
+    m = base.shape[0]
     s_total = config.n_sectors
     n = config.n_bins
     seen = total > 0
@@ -609,7 +613,10 @@ def _log_likelihoods_of(
     nz_group, nz_code = np.nonzero(counts)
     z = counts[nz_group, nz_code] / total[nz_group]
     rows = nz_code * n + log2_bin(z, n)
-    gathered = np.take(delta_t, rows, axis=0)  # (E, M, S)
+    if maps is None:
+        gathered = np.take(delta_t, rows, axis=0)  # (E, M, S)
+    else:
+        gathered = delta_t[rows[:, None], maps[None, :]]
     starts = np.flatnonzero(np.r_[True, nz_group[1:] != nz_group[:-1]])
     per_group = np.zeros((counts.shape[0], m, s_total))
     per_group[nz_group[starts]] = np.add.reduceat(gathered, starts, axis=0)

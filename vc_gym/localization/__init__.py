@@ -14,6 +14,10 @@ Every tracker satisfies :class:`Tracker`: ``reset(atlas, camera, dt_s)`` and
 * :class:`KalmanTracker` -- an unscented Kalman heading filter and the translational
   filter.
 
+Each takes ``shortlist=k`` to score only the ``k`` best-fitting spots between full
+scorings (:class:`SpotShortlist`): an atlas with many spots then costs about ``k``
+maps a frame.
+
 :func:`make_tracker` builds one from a name, a ``{"type": name, **kwargs}`` dict or a
 callable; :func:`register_tracker` adds a name.
 
@@ -34,6 +38,7 @@ from vc_gym.localization.sensors import (
     CompassHeadingSensor,
     best_spot_heading_log_likelihood,
 )
+from vc_gym.localization.shortlist import SpotShortlist
 
 __all__ = [
     "TRACKERS",
@@ -43,6 +48,7 @@ __all__ = [
     "GridTracker",
     "KalmanTracker",
     "ParticleTracker",
+    "SpotShortlist",
     "Tracker",
     "TrackerSpec",
     "TrackerState",

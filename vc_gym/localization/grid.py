@@ -14,6 +14,7 @@ from vc_gym.localization.protocol import (
     check_reset_inputs,
 )
 from vc_gym.localization.sensors import best_spot_heading_log_likelihood
+from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["GridTracker"]
@@ -44,6 +45,10 @@ class GridTracker:
         Fraction of each odometry turn added to the heading blur.
     rule : str
         ``"mixing"`` (paper eq. 24) or ``"bayes"`` (the proper product).
+    shortlist, rescore_every : int
+        Score every spot only every ``rescore_every`` frames and, in between, the
+        ``shortlist`` spots that fitted best (:class:`SpotShortlist`). The default
+        ``shortlist=None`` (the paper) scores every spot every frame.
     """
 
     def __init__(
@@ -53,6 +58,8 @@ class GridTracker:
         motion_noise_deg: float = 0.5,
         turn_noise: float = 0.1,
         rule: str = "mixing",
+        shortlist: int | None = None,
+        rescore_every: int = 4,
     ):
         self.half_life_s = positive_float("half_life_s", half_life_s)
         self.heading_resolution_deg = positive_float(
@@ -61,6 +68,7 @@ class GridTracker:
         self.motion_noise_deg = nonnegative_float("motion_noise_deg", motion_noise_deg)
         self.turn_noise = nonnegative_float("turn_noise", turn_noise)
         self.rule = rule
+        self.spots = SpotShortlist(shortlist, rescore_every)
         # fail now, not at the first reset
         HeadingGridFilter(self.heading_resolution_deg, rule=rule, half_life_s=self.half_life_s)
         self.atlas: CompassAtlas | None = None
@@ -73,6 +81,7 @@ class GridTracker:
             self.heading_resolution_deg, rule=self.rule, half_life_s=self.half_life_s, dt_s=dt
         )
         self.position_filter = AtlasPositionFilter(atlas, self.half_life_s, dt)
+        self.spots.reset()
 
     def update(
         self, image: np.ndarray, head_pan_deg: float, odometry: np.ndarray | tuple
@@ -83,7 +92,7 @@ class GridTracker:
         )
         hf, pf = self.heading_filter, self.position_filter
         hf.predict(turn, noise_deg=self.motion_noise_deg + self.turn_noise * abs(turn))
-        est = self.atlas.estimate_position(image, self.camera)
+        est = self.spots.estimate(self.atlas, image, self.camera)
         hf.update_log_likelihood(
             best_spot_heading_log_likelihood(self.atlas, est, hf.headings_deg + pan)
         )

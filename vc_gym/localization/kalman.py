@@ -20,6 +20,7 @@ from vc_gym.localization.sensors import (
     best_spot_heading_log_likelihood,
     tempered_distribution,
 )
+from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["KalmanTracker"]
@@ -52,6 +53,10 @@ class KalmanTracker:
         Innovation gate in standard deviations (``inf``: never reject).
     max_rejections : int
         Consecutive rejections after which the filter restarts on the measurement.
+    shortlist, rescore_every : int
+        Score every spot only every ``rescore_every`` frames and, in between, the
+        ``shortlist`` spots that fitted best (:class:`SpotShortlist`). The default
+        ``shortlist=None`` (the paper) scores every spot every frame.
     """
 
     def __init__(
@@ -63,6 +68,8 @@ class KalmanTracker:
         min_spread_deg: float = 2.0,
         gate_sigma: float = 3.0,
         max_rejections: int = 10,
+        shortlist: int | None = None,
+        rescore_every: int = 4,
     ):
         self.half_life_s = positive_float("half_life_s", half_life_s)
         self.motion_noise_deg = nonnegative_float("motion_noise_deg", motion_noise_deg)
@@ -78,6 +85,7 @@ class KalmanTracker:
         if max_rejections < 1:
             raise ValueError(f"max_rejections must be an int >= 1, got {max_rejections!r}")
         self.max_rejections = max_rejections
+        self.spots = SpotShortlist(shortlist, rescore_every)
         self.headings_deg = np.arange(360, dtype=np.float64)
         self.atlas: CompassAtlas | None = None
 
@@ -87,6 +95,7 @@ class KalmanTracker:
         self.atlas, self.camera = atlas, camera
         self.heading_filter = KalmanHeadingFilter(0.0, 180.0)
         self.position_filter = AtlasPositionFilter(atlas, self.half_life_s, dt)
+        self.spots.reset()
         self.rejections = 0
 
     def _measurement(self, ll: np.ndarray) -> tuple[float, float] | None:
@@ -105,7 +114,7 @@ class KalmanTracker:
         )
         kf, pf = self.heading_filter, self.position_filter
         kf.predict(turn, noise_deg=self.motion_noise_deg + self.turn_noise * abs(turn))
-        est = self.atlas.estimate_position(image, self.camera)
+        est = self.spots.estimate(self.atlas, image, self.camera)
         ll = best_spot_heading_log_likelihood(self.atlas, est, self.headings_deg + pan)
         z = self._measurement(ll)
         if z is not None and math.isfinite(z[1]):

@@ -17,6 +17,7 @@ from vc_gym.localization.sensors import (
     best_spot_heading_log_likelihood,
     tempered_distribution,
 )
+from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["ParticleTracker"]
@@ -88,6 +89,10 @@ class ParticleTracker:
     seed : int
         Every :meth:`reset` draws from ``numpy.random.default_rng(seed)``, so an episode
         does not depend on the episodes before it.
+    shortlist, rescore_every : int
+        Score every spot only every ``rescore_every`` frames and, in between, the
+        ``shortlist`` spots that fitted best (:class:`SpotShortlist`). The default
+        ``shortlist=None`` (the paper) scores every spot every frame.
     """
 
     def __init__(
@@ -101,6 +106,8 @@ class ParticleTracker:
         inject_fraction: float = 0.05,
         motion_noise: tuple[float, float, float] = (0.03, 0.03, 2.0),
         seed: int = 0,
+        shortlist: int | None = None,
+        rescore_every: int = 4,
     ):
         if isinstance(n_particles, bool) or not isinstance(n_particles, int) or n_particles < 1:
             raise ValueError(f"n_particles must be an int >= 1, got {n_particles!r}")
@@ -122,6 +129,7 @@ class ParticleTracker:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
             raise ValueError(f"seed must be an int, got {seed!r}")
         self.seed = int(seed)
+        self.spots = SpotShortlist(shortlist, rescore_every)
         self.atlas: CompassAtlas | None = None
 
     def field_bounds(self, atlas: CompassAtlas) -> tuple[float, float, float, float]:
@@ -145,6 +153,7 @@ class ParticleTracker:
             inject_fraction=self.inject_fraction,
         )
         self._fresh = True
+        self.spots.reset()
         self.sensor = AtlasPoseSensor(
             atlas, camera, self.position_noise_m, self.heading_temperature
         )
@@ -173,7 +182,7 @@ class ParticleTracker:
         pf.predict(
             (fwd, left, turn), (sf + 0.1 * abs(fwd), sl + 0.1 * abs(left), st + 0.1 * abs(turn))
         )
-        est = self.atlas.estimate_position(image, self.camera)
+        est = self.spots.estimate(self.atlas, image, self.camera)
         if self._fresh:  # the first frame: every particle from the sensor
             pf.replace(np.arange(self.n_particles), self._sensor_poses(est, pan, self.n_particles))
             self._fresh = False

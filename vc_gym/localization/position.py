@@ -46,9 +46,10 @@ class AtlasPositionFilter:
         self.filter.predict(*body_to_world(forward, left, heading_deg))
 
     def update(self, estimate: AtlasEstimate) -> None:
-        """Mix in the frame's atlas position (eq. 32) and its weighted spread."""
+        """Mix in the frame's atlas position (eq. 32) and its weighted spread (spots the
+        estimate did not score weigh nothing)."""
         self.filter.update_position(estimate.position)
-        w = np.array([estimate.weights[n] for n in self.names])
+        w = np.array([estimate.weights.get(n, 0.0) for n in self.names])
         var = w @ (self.spots - np.asarray(estimate.position)) ** 2
         self._var = self.lam * var + (1.0 - self.lam) * self._var
 

@@ -45,7 +45,7 @@ class TrackerState:
         tracker (see its docstring); larger always means less sure.
     goodness : numpy.ndarray
         Normalised goodness ``L̂_i`` of each spot for this frame (eq. 28), in
-        ``atlas.names`` order.
+        ``atlas.names`` order; 0 for a spot the tracker did not score this frame.
     belief : numpy.ndarray
         The heading belief on a uniform circular grid starting at 0° (``belief[k]``
         is the probability of heading ``k * 360 / belief.size``); sums to 1.
@@ -141,13 +141,14 @@ def atlas_tracker_state(
     position_std_m: tuple[float, float],
     belief: np.ndarray,
 ) -> TrackerState:
-    """A :class:`TrackerState` whose goodness and atlas position come from ``estimate``."""
+    """A :class:`TrackerState` whose goodness and atlas position come from ``estimate``
+    (a spot the estimate did not score reports goodness 0)."""
     return TrackerState(
         heading_deg=float(heading_deg),
         heading_spread_deg=float(min(heading_spread_deg, 180.0)),
         position=(float(position[0]), float(position[1])),
         position_std_m=(float(position_std_m[0]), float(position_std_m[1])),
-        goodness=np.array([estimate.goodness[n] for n in atlas.names]),
+        goodness=np.array([estimate.goodness.get(n, 0.0) for n in atlas.names]),
         belief=belief,
         atlas_position=(float(estimate.position[0]), float(estimate.position[1])),
     )
