@@ -77,6 +77,33 @@ def test_pitch_is_handled(room_pano, room_compass):
     assert np.mean(errs < 5.0) >= 0.9
 
 
+@pytest.mark.parametrize(
+    "camera",
+    [
+        Camera(),
+        Camera(pitch_deg=8.0),
+        Camera(hfov_deg=90.0, principal_point=(70.0, 60.0)),
+        Camera(hfov_deg=20.0),
+    ],
+)
+def test_sector_counts_are_the_columns_summed_by_sector(room_pano, room_compass, camera):
+    """Each (heading phase, relative sector) row sums the scanned columns that look into
+    that sector (the counts behind eq. 11, per sector)."""
+    image = render_view(room_pano, camera.replace(yaw_deg=33.0))
+    geom, counts, total = room_compass._sector_features(image, camera)
+    colcounts = room_compass._column_counts(image, geom)
+    delta = room_compass.config.sector_deg
+    headings = room_compass._headings
+    phases = np.unique(np.round(headings - np.floor(headings / delta + 1e-9) * delta, 9))
+    expected = np.zeros_like(counts)
+    for p, phase in enumerate(phases):
+        k = np.floor((phase + geom.grid.offsets_deg) / delta).astype(int) - geom.kmin
+        for u in range(colcounts.shape[0]):
+            expected[p * geom.n_rel + k[u]] += colcounts[u]
+    np.testing.assert_array_equal(counts, expected)
+    np.testing.assert_array_equal(total, expected.sum(axis=1))
+
+
 @pytest.mark.parametrize("illumination", [0.5, 0.25, 1.5])
 def test_exposure_mean_undoes_illumination_changes(room_pano, illumination, make_learned_compass):
     # paper 5.3 tests half the illumination of learning; exposure="mean" undoes it

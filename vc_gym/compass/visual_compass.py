@@ -73,7 +73,10 @@ class _Geometry:
     grid: ScanGrid
     row_slice: slice
     col_slice: slice
-    assign: np.ndarray  # (P*K, U) float32: column u belongs to relative sector k at phase p
+    # (P*K,) each: the scanned columns ``first[r] <= u < stop[r]`` fall into relative
+    # sector k at phase p, r = p*K + k (columns look at monotonically falling directions)
+    first_col: np.ndarray
+    stop_col: np.ndarray
     kmin: int
     n_rel: int  # K
     heading_phase: np.ndarray  # (n_headings,) phase index of each heading
@@ -275,15 +278,27 @@ class VisualCompass:
         kmin = int(k.min())
         n_rel = int(k.max()) - kmin + 1
         n_p, n_u = k.shape
-        assign = np.zeros((n_p * n_rel, n_u), dtype=np.float32)
-        rows = np.arange(n_p)[:, None] * n_rel + (k - kmin)
-        assign[rows.ravel(), np.tile(np.arange(n_u), n_p)] = 1.0
+        # the columns of one (phase, relative sector) are a contiguous run: their counts
+        # are a difference of cumulative sums (a product with a 0/1 matrix instead makes
+        # OpenBLAS start a second thread that then spins on a core of its own)
+        rows = np.arange(n_p)[:, None] * n_rel + (k - kmin)  # (P, U)
+        if np.any(np.diff(k, axis=1) > 0):
+            raise RuntimeError("scan columns must look at falling directions")
+        first_col = np.zeros(n_p * n_rel, dtype=np.intp)
+        stop_col = np.zeros(n_p * n_rel, dtype=np.intp)
+        cols = np.broadcast_to(np.arange(n_u), rows.shape)
+        np.maximum.at(stop_col, rows.ravel(), cols.ravel() + 1)
+        first_col[:] = n_u
+        np.minimum.at(first_col, rows.ravel(), cols.ravel())
+        empty = stop_col == 0
+        first_col[empty] = 0
         roll = (np.arange(s_total)[None, :] + np.arange(n_rel)[:, None] + kmin) % s_total
         geom = _Geometry(
             grid=grid,
             row_slice=row_slice,
             col_slice=col_slice,
-            assign=assign,
+            first_col=first_col,
+            stop_col=stop_col,
             kmin=kmin,
             n_rel=n_rel,
             heading_phase=heading_phase.astype(np.intp),
@@ -400,7 +415,10 @@ class VisualCompass:
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
         colcounts = self._column_counts(image, geom)
-        counts = geom.assign @ colcounts  # (P*K, c2)
+        # integer counts in float32: the cumulative sums and their differences are exact
+        cum = np.zeros((colcounts.shape[0] + 1, colcounts.shape[1]), dtype=colcounts.dtype)
+        np.cumsum(colcounts, axis=0, out=cum[1:])
+        counts = cum[geom.stop_col] - cum[geom.first_col]  # (P*K, c2)
         total = counts.sum(axis=1)
         return geom, counts, total
 
