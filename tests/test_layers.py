@@ -1,7 +1,8 @@
 """Layers point one way: every import in the package, lazy ones included, is checked.
 
 The order (DESIGN.md): the base helpers, then ``compass``, ``filters``, ``localization``,
-``worlds``, ``envs``, ``baselines``, ``agents``, ``experiments``, ``cli``. A module may
+``worlds``, ``envs``, ``baselines``, ``agents``, ``experiments``, ``hyperparams`` (the RL
+Zoo's settings), ``cli``. A module may
 import only its own layer and the layers before it; ``compass`` and ``filters`` never
 import each other (``localization`` joins them).
 """
@@ -16,7 +17,16 @@ import pytest
 import vc_gym
 
 PACKAGE = Path(vc_gym.__file__).parent
-BASE = {"angles", "images", "validation", "persistence", "errors", "exposure", "poses"}
+BASE = {
+    "angles",
+    "images",
+    "validation",
+    "persistence",
+    "config_files",
+    "errors",
+    "exposure",
+    "poses",
+}
 ORDER = [
     "base",
     "compass",
@@ -27,6 +37,7 @@ ORDER = [
     "baselines",
     "agents",
     "experiments",
+    "hyperparams",
     "cli",
 ]
 #: pairs (importer, imported) that are forbidden even though the order allows them

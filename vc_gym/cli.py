@@ -48,20 +48,79 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return _cmd_experiment(args)
 
 
-def _cmd_train(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.training import TrainConfig, train
+#: ``vc-gym train`` options that set a :class:`TrainConfig` field of the same name.
+_TRAIN_FIELDS = {
+    "algo": "algo",
+    "timesteps": "timesteps",
+    "n_envs": "n_envs",
+    "seed": "seed",
+    "scene": "scene",
+    "learn_time": "learn_time_s",
+    "tracker": "tracker",
+    "eval_freq": "eval_freq",
+    "eval_episodes": "eval_episodes",
+    "save_freq": "save_freq",
+}
 
-    config = TrainConfig(
-        algo=args.algo,
-        timesteps=args.timesteps,
-        n_envs=args.n_envs,
-        seed=args.seed,
-        scene=args.scene,
-        learn_time_s=args.learn_time,
-        tracker=args.tracker,
-        vec_env="dummy" if args.n_envs == 1 else "subproc",
+
+def _train_sweep(args: argparse.Namespace, config, out: Path) -> int:
+    from vc_gym.experiments.runner import make_backend
+    from vc_gym.experiments.training_sweep import FIGURES, run_train_sweep
+
+    with make_backend(args.backend, args.workers, args.address) as backend:
+        r = run_train_sweep(out, config, args.seeds, backend, progress=not args.json)
+    if args.json:
+        print(json.dumps(r))
+        return 1 if r["failed_jobs"] else 0
+    for name in FIGURES:
+        m = r["over_seeds"][name]
+        if m["n"]:
+            print(f"{name:26s} {m['mean']:.3f} ± {m['std']:.3f} over {m['n']} seeds")
+    for f in r["failed_jobs"]:
+        print(f"FAILED {f['key']}: {f['error']}")
+    print(f"wrote {out / 'results.json'} and one run folder per seed")
+    return 1 if r["failed_jobs"] else 0
+
+
+def _cmd_train(args: argparse.Namespace) -> int:
+    from vc_gym.experiments.runner import check_out_dir
+    from vc_gym.experiments.training import TrainConfig, read_train_config, train
+
+    given = {
+        field: getattr(args, opt)
+        for opt, field in _TRAIN_FIELDS.items()
+        if getattr(args, opt) is not None
+    }
+    if "n_envs" in given:
+        given["vec_env"] = "dummy" if given["n_envs"] == 1 else "subproc"
+    if args.seeds is not None and (args.resume or "seed" in given or args.tensorboard_log):
+        raise ValueError("--seeds runs a sweep: no --seed, --resume or --tensorboard-log with it")
+    if args.resume:
+        if args.config or args.out:
+            raise ValueError("--resume DIR continues that run: no --config or --out with it")
+        unchanged = set(given) - {"timesteps"}
+        if unchanged:
+            raise ValueError(
+                f"--resume keeps the run's settings; only --timesteps may change, "
+                f"got {sorted(unchanged)}"
+            )
+        out = Path(args.resume)
+        config = read_train_config(out / "config.json", **given)
+    else:
+        out = check_out_dir(args.out or "vc_gym_agent")
+        if args.config:
+            config = read_train_config(args.config, **given)
+        else:
+            config = TrainConfig(**given)
+    if args.seeds is not None:
+        return _train_sweep(args, config, out)
+    s = train(
+        config,
+        out,
+        progress=not args.json,
+        tensorboard_log=args.tensorboard_log,
+        resume=bool(args.resume),
     )
-    s = train(config, args.out, progress=not args.json)
     if args.json:
         print(json.dumps(s))
     else:
@@ -146,6 +205,19 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                     f"{r['wall_s']:.0f} s), x{ratio:.2f} of one local worker"
                 )
             print(f"byte-identical results.json on every backend: {result['identical_results']}")
+    elif args.what == "train":
+        from vc_gym.experiments.bench_train import bench_train
+
+        result = bench_train(
+            timesteps=args.timesteps, n_envs=args.n_envs, seed=args.seed, progress=not args.json
+        )
+        if not args.json:
+            print(
+                f"training {result['train_decisions_per_s']:.1f} decisions/s with "
+                f"{result['n_envs']} workers; one env alone {result['env_decisions_per_s']:.1f} "
+                f"decisions/s; efficiency {result['efficiency']:.2f} of "
+                f"{result['n_envs']} x the env's rate (target {result['target_efficiency']})"
+            )
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:
@@ -417,12 +489,15 @@ def build_parser() -> argparse.ArgumentParser:
             "room with a 4-spot atlas, next to the atlas alone. backends: jobs per second of "
             "the homing experiment's episodes with 1 local worker, --workers local workers and "
             "a local Ray instance of --workers CPUs (atlas learned once; the results must be "
-            "byte-identical). The last line of --json output is one JSON object."
+            "byte-identical). train: agent decisions per second of PPO training with --n-envs "
+            "workers next to one vc_gym/Homing-v0 stepping alone (before and after, same run), "
+            "and their ratio (efficiency; target 0.7). The last line of --json output is one "
+            "JSON object."
         ),
     )
     p.add_argument(
         "what",
-        choices=["compass", "filters", "env", "trackers", "backends"],
+        choices=["compass", "filters", "env", "trackers", "backends", "train"],
         help="what to benchmark",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
@@ -436,6 +511,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--workers", type=int, default=2, help="backends: workers of the parallel backends"
     )
+    p.add_argument("--timesteps", type=int, default=2048, help="train: decisions to train for")
+    p.add_argument("--n-envs", type=int, default=2, help="train: worker processes")
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=_cmd_bench)
 
@@ -509,25 +586,68 @@ def build_parser() -> argparse.ArgumentParser:
             "DIR/train_log.json and DIR/learning_curve.png."
         ),
     )
-    p.add_argument("--algo", choices=["ppo", "sac"], default="ppo", help="algorithm")
-    p.add_argument("--timesteps", type=int, default=60_000, help="agent decisions to train for")
-    p.add_argument("--out", default="vc_gym_agent", metavar="DIR", help="output folder")
-    p.add_argument("--n-envs", type=int, default=2, help="parallel environments (processes)")
-    p.add_argument("--seed", type=int, default=0)
+    # every setting defaults to None here: a value given on the command line overrides
+    # --config FILE, which overrides TrainConfig's defaults
+    p.add_argument(
+        "--config",
+        metavar="FILE",
+        help="YAML or JSON file of TrainConfig fields (any subset; a run's config.json works)",
+    )
+    p.add_argument("--algo", choices=["ppo", "sac"], help="algorithm (default ppo)")
+    p.add_argument("--timesteps", type=int, help="agent decisions to train for (default 60000)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default vc_gym_agent)")
+    p.add_argument("--n-envs", type=int, help="parallel environments (processes; default 2)")
+    p.add_argument("--seed", type=int, help="seed of the model, the envs and the learning phase")
     p.add_argument(
         "--scene",
-        default="robolab",
         choices=_SceneChoices(),
         metavar="SCENE",
         help="scene to train in (default: robolab): %(choices)s",
     )
-    p.add_argument("--learn-time", type=float, default=5.0, help="seconds per learning direction")
+    p.add_argument("--learn-time", type=float, help="seconds per learning direction (default 5)")
     p.add_argument(
         "--tracker",
-        default="grid",
         metavar="NAME",
-        help="tracker of the agent's env: grid (the paper's filters), particle or kalman",
+        help="tracker of the agent's env: grid (the paper's filters, default), particle or kalman",
     )
+    p.add_argument(
+        "--eval-freq",
+        type=int,
+        help="decisions between evaluations on held-out kidnappings, best model kept in "
+        "DIR/best (default 10000; 0: none)",
+    )
+    p.add_argument("--eval-episodes", type=int, help="kidnappings per evaluation (default 10)")
+    p.add_argument(
+        "--save-freq",
+        type=int,
+        help="decisions between checkpoints in DIR/checkpoints (default 0: none)",
+    )
+    p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
+    p.add_argument(
+        "--resume",
+        metavar="DIR",
+        help="continue the run in DIR from its latest checkpoint (its config.json; "
+        "--timesteps may extend it)",
+    )
+    p.add_argument(
+        "--seeds",
+        type=_int_list,
+        metavar="S,S,...",
+        help="a sweep: one full training run per seed in DIR/seed-<s>, as jobs of the "
+        "experiment runner, and DIR/results.json with every run's figures and their mean "
+        "± std (rerun to resume)",
+    )
+    p.add_argument(
+        "--backend", choices=["local", "ray"], default="local", help="--seeds: who runs the runs"
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help="--seeds: runs at a time (local, default 1: each run has --n-envs workers of "
+        "its own) or CPUs of the local Ray instance",
+    )
+    p.add_argument("--address", metavar="ADDR", help="--seeds with ray: join this cluster")
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_train)
 

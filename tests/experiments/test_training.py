@@ -15,14 +15,23 @@ from vc_gym.experiments.studies.homing import run_homing
 from vc_gym.experiments.training import TrainConfig, train
 
 TINY = TrainConfig(
-    timesteps=64, n_envs=2, learn_time_s=0.2, n_steps=32, batch_size=32, max_homing_s=3.0
+    timesteps=64,
+    n_envs=2,
+    learn_time_s=0.2,
+    n_steps=32,
+    batch_size=32,
+    max_homing_s=3.0,
+    eval_freq=32,
+    eval_episodes=2,
+    save_freq=32,
 )
 
 
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
     out = tmp_path_factory.mktemp("agent")
-    summary = train(TINY, out, progress=False)  # SubprocVecEnv, 2 worker processes
+    tb = out / "tb"
+    summary = train(TINY, out, progress=False, tensorboard_log=tb)  # 2 worker processes
     return out, summary
 
 
@@ -35,6 +44,82 @@ def test_train_writes_model_config_and_log(trained):
     log = json.loads((out / "train_log.json").read_text())
     assert log["episodes"] == len(log["per_episode"]) == summary["episodes"] > 0
     assert (out / "learning_curve.png").read_bytes()[:4] == b"\x89PNG"
+    # the place was learned once, in the parent, and shared by both workers
+    assert (out / "atlas.npz").is_file()
+    assert summary["decisions_per_s"] > 0
+
+
+def test_train_writes_what_an_sb3_user_expects(trained):
+    out, summary = trained
+    # SB3's per-worker monitor logs: a JSON header line, a CSV header, one row per episode
+    for rank in (0, 1):
+        lines = (out / "monitor" / f"{rank}.monitor.csv").read_text().splitlines()
+        assert lines[0].startswith("#{") and lines[1].startswith("r,l,t")
+    rows = sum(
+        len((out / "monitor" / f"{r}.monitor.csv").read_text().splitlines()) - 2 for r in (0, 1)
+    )
+    assert rows == summary["episodes"]
+    # evaluations on held-out kidnappings (every 32 decisions), the best model kept
+    with np.load(out / "eval" / "evaluations.npz") as ev:
+        assert list(ev["timesteps"]) == [32, 64] and ev["results"].shape == (2, 2)
+    assert summary["best_model"] == str(out / "best" / "best_model.zip")
+    assert sorted(p.name for p in (out / "checkpoints").iterdir()) == [
+        "model_32_steps.zip",
+        "model_64_steps.zip",
+    ]
+    assert any(p.name.startswith("events.out.tfevents") for p in (out / "tb").rglob("*"))
+
+
+def test_resume_continues_from_the_latest_checkpoint(trained, tmp_path, capsys):
+    import shutil
+
+    out, first = trained
+    run = tmp_path / "run"
+    shutil.copytree(out, run)
+    code = main(["train", "--resume", str(run), "--timesteps", "96", "--json"])
+    assert code == 0
+    s = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert s["resumed_from"] == str(run / "checkpoints" / "model_64_steps.zip")
+    assert (run / "checkpoints" / "model_96_steps.zip").is_file()
+    log = json.loads((run / "train_log.json").read_text())["per_episode"]
+    assert (
+        log[: first["episodes"]] == json.loads((out / "train_log.json").read_text())["per_episode"]
+    )
+    # PPO ends on whole rollouts (2 envs x 32 steps): 96 asked, 128 done
+    assert len(log) >= first["episodes"] and all(e["timestep"] <= 128 for e in log)
+    assert TrainConfig.from_dict(json.loads((run / "config.json").read_text())).timesteps == 96
+    # the settings of a run are kept: only --timesteps may change
+    assert main(["train", "--resume", str(run), "--seed", "3"]) == 2
+    assert "only --timesteps" in capsys.readouterr().err
+
+
+def test_config_file_and_command_line(tmp_path):
+    from vc_gym.experiments.training import read_train_config
+
+    cfg = tmp_path / "ppo.yml"
+    cfg.write_text("algo: ppo\nnet_arch: [32, 32]\nlearning_rate: 0.001\nscene: office\n")
+    config = read_train_config(cfg, timesteps=500)
+    assert config.net_arch == (32, 32) and config.learning_rate == 0.001
+    assert config.scene == "office" and config.timesteps == 500 and config.gamma == 0.99
+    # a run's own config.json reads back as the same config
+    saved = tmp_path / "config.json"
+    saved.write_text(json.dumps(TINY.to_dict()))
+    assert read_train_config(saved) == TINY
+    bad = tmp_path / "bad.yml"
+    bad.write_text("reward: 3\n")
+    with pytest.raises(ValueError, match="bad.yml.*unknown"):
+        read_train_config(bad)
+
+
+def test_the_speed_benchmark_reports_training_next_to_the_env():
+    from vc_gym.experiments.bench_train import bench_train
+
+    r = bench_train(timesteps=32, n_envs=1, env_steps=10, learn_time_s=0.2, progress=False)
+    assert r["n_envs"] == 1 and len(r["env_rounds_decisions_per_s"]) == 2
+    assert r["env_decisions_per_s"] > 0 and r["train_decisions_per_s"] > 0
+    assert r["efficiency"] == pytest.approx(
+        r["train_decisions_per_s"] / r["env_decisions_per_s"], rel=0.01
+    )
 
 
 def test_reloaded_model_gives_the_same_actions(trained):
@@ -118,3 +203,23 @@ def test_config_file_round_trip_and_errors(tmp_path):
         TrainConfig.from_dict({**TINY.to_dict(), "env": {"scene": "office"}})
     schema1 = {k: v for k, v in TINY.to_dict().items() if k not in ("env", "tracker")}
     assert TrainConfig.from_dict({**schema1, "schema": 1}) == TINY
+
+
+def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
+    cfg = tmp_path / "tiny.json"
+    cfg.write_text(json.dumps({**TINY.to_dict(), "save_freq": 0, "eval_freq": 64}))
+    out = tmp_path / "sweep"
+    argv = ["train", "--seeds", "0,1", "--config", str(cfg), "--out", str(out), "--json"]
+    assert main(argv) == 0
+    r = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert set(r["runs"]) == {"seed-0", "seed-1"} and r["settings"]["seeds"] == [0, 1]
+    for s in (0, 1):
+        saved = json.loads((out / f"seed-{s}" / "config.json").read_text())
+        assert saved["seed"] == s and (out / f"seed-{s}" / "model.zip").is_file()
+    returns = [r["runs"][k]["eval_final_mean_return"] for k in ("seed-0", "seed-1")]
+    summary = r["over_seeds"]["eval_final_mean_return"]
+    assert summary["n"] == 2 and summary["mean"] == pytest.approx(np.mean(returns), abs=1e-3)
+    before = (out / "results.json").read_bytes()
+    assert main(argv) == 0  # resumed: nothing trained again, the same figures
+    assert (out / "results.json").read_bytes() == before
+    assert main([*argv[:-1], "--seed", "3"]) == 2

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -12,6 +14,7 @@ from gymnasium import spaces
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.envs.learning import (
     HOME,
     Learner,
@@ -22,7 +25,7 @@ from vc_gym.envs.learning import (
     kidnap_pose,
 )
 from vc_gym.poses import compose
-from vc_gym.validation import nonnegative_float, positive_float
+from vc_gym.validation import int_at_least, nonnegative_float, positive_float
 
 __all__ = ["LearnThenHomeEnv", "LEARNING_MODES"]
 
@@ -106,7 +109,14 @@ class LearnThenHomeEnv(gym.Env):
     arguments); the result is kept as ``learning_result``. ``normalise_at="return"``
     (the paper) normalises the spots after walking back home by odometry;
     ``"start"`` uses the frames of the first turn, taken at the true home (the stops
-    then lose the offset of the walk back's odometry drift).
+    then lose the offset of the walk back's odometry drift). ``learning_seed`` seeds the
+    room for the learning phase on its own (default: drawn from the reset seed), so that
+    envs reset with different seeds learn the same place the same way.
+    ``atlas_file="place.npz"`` keeps the learning phase's atlas in that file: the first
+    env to need it learns and writes it, every later one (other workers too, under a
+    lock) loads it instead of learning; a file learned with other settings is refused.
+    With an ``atlas_file``, episodes do not depend on whether this env learned or
+    loaded the atlas.
 
     ## Info
 
@@ -140,6 +150,8 @@ class LearnThenHomeEnv(gym.Env):
         compass: CompassConfig | None = None,
         learner: Learner | None = None,
         normalise_at: str = "return",
+        learning_seed: int | None = None,
+        atlas_file: str | os.PathLike | None = None,
         **room_kwargs: Any,
     ):
         if learning not in LEARNING_MODES:
@@ -173,11 +185,19 @@ class LearnThenHomeEnv(gym.Env):
         if learner is not None and not callable(learner):
             raise ValueError(f"learner must be callable(room, config), got {learner!r}")
 
+        if learning_seed is not None:
+            int_at_least("learning_seed", learning_seed, 0)
+        if atlas_file is not None and learning != "scripted":
+            raise ValueError("atlas_file needs learning='scripted' (the agent learns its own)")
+        if atlas_file is not None and room_kwargs.get("randomize"):
+            raise ValueError("atlas_file cannot be shared by randomised scenes (each differs)")
         self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
         self.render_mode = render_mode
         self.learning = learning
         self.relearn = relearn
         self.learner = learner if learner is not None else ScriptedLearning()
+        self.learning_seed = learning_seed
+        self.atlas_file = atlas_file
         self.learn_config = LearningConfig(
             spot_distance_m=float(spot_distance_m),
             learn_time_s=float(learn_time_s),
@@ -193,6 +213,15 @@ class LearnThenHomeEnv(gym.Env):
         self.progress_reward = float(progress_reward)
         self.success_bonus = float(success_bonus)
         self.fall_penalty = float(fall_penalty)
+        if atlas_file is not None:
+            spec = {
+                "scene": self.room.scene_name,
+                "learner": repr(self.learner),
+                "learning": dataclasses.asdict(self.learn_config),
+                "learning_seed": learning_seed,
+                "room": {k: repr(v) for k, v in sorted(room_kwargs.items())},
+            }
+            self.learner = AtlasFile(atlas_file, self.learner, spec)
         self.max_spots = 4 if learning == "scripted" else int(max_spots)
         self.spot_radius_m = float(spot_radius_m)
         self.control_dt = self.room.control_dt
@@ -275,7 +304,8 @@ class LearnThenHomeEnv(gym.Env):
         ):  # the place is known: straight to the kidnapping
             obs, info = self._kidnap(options, seed=room_seed)
             return self._obs(obs), self._info(info)
-        obs, info = self.room.reset(seed=room_seed, options={"pose": (*HOME, 0.0)})
+        learn_seed = room_seed if self.learning_seed is None else self.learning_seed
+        obs, info = self.room.reset(seed=learn_seed, options={"pose": (*HOME, 0.0)})
         if self.learning == "agent":
             self.atlas = self.learning_result = None
             self._frames = []
@@ -299,7 +329,9 @@ class LearnThenHomeEnv(gym.Env):
                 )
             self.learning_result, self.atlas = result, result.atlas
             self._atlas_key = key
-        obs, info = self._kidnap(options)
+        # with a shared atlas file the room is reseeded, so that whether this env learned
+        # or loaded the atlas does not change its episodes
+        obs, info = self._kidnap(options, seed=room_seed if self.atlas_file else None)
         return self._obs(obs), self._info(info)
 
     def step(

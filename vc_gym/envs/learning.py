@@ -400,6 +400,9 @@ class ScriptedLearning:
     def __init__(self, progress: bool = False):
         self.progress = bool(progress)
 
+    def __repr__(self) -> str:
+        return "ScriptedLearning()"
+
     def __call__(self, room, config: LearningConfig) -> LearningResult:
         return ScriptedLearner(room, config, progress=self.progress).learn()
 

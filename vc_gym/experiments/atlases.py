@@ -22,7 +22,8 @@ from typing import Any
 import gymnasium as gym
 
 from vc_gym.compass import CompassAtlas, CompassConfig
-from vc_gym.envs.learning import GridLearning, LearningConfig, LearningResult, SpotLearning
+from vc_gym.envs.atlas_file import SavedAtlas
+from vc_gym.envs.learning import GridLearning, LearningConfig, SpotLearning
 from vc_gym.errors import MapFileError
 from vc_gym.experiments.runner import ExperimentRun, Job
 from vc_gym.persistence import write_atomic
@@ -105,31 +106,6 @@ def atlas_key(spec: Mapping[str, Any]) -> str:
     """File-name key of an atlas spec: readable prefix + hash of the whole spec."""
     digest = hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:10]
     return f"{spec['scene']}-{spec['learner']}-seed{spec['seed']}-{digest}"
-
-
-class SavedAtlas:
-    """A task learner that loads a saved atlas instead of learning (no robot motion).
-
-    Parameters
-    ----------
-    path : path-like
-        An atlas written by :meth:`CompassAtlas.save`.
-    """
-
-    def __init__(self, path: str | os.PathLike):
-        self.path = Path(path)
-
-    def __call__(self, room, config: LearningConfig) -> LearningResult:
-        atlas, meta = CompassAtlas.load_with_metadata(self.path)
-        if atlas.compasses[0].config != config.compass:
-            raise MapFileError(
-                f"{self.path}: learned with {atlas.compasses[0].config}, the task expects "
-                f"{config.compass}"
-            )
-        spots = {n: tuple(map(float, p)) for n, p in zip(atlas.names, atlas.positions, strict=True)}
-        return LearningResult(
-            atlas, spots, odometry_turn_scale=float(meta.get("odometry_turn_scale", 1.0))
-        )
 
 
 def _learner(spec: Mapping[str, Any]):

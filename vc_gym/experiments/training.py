@@ -9,9 +9,11 @@ processes (``SubprocVecEnv``) and writes ``model.zip``, ``config.json``,
 
 from __future__ import annotations
 
+import json
 import os
 import time
-from dataclasses import asdict, dataclass, fields
+import warnings
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -19,11 +21,12 @@ import gymnasium as gym
 import numpy as np
 
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
+from vc_gym.config_files import read_settings
 from vc_gym.experiments.output import new_figure, save_figure, write_json
 from vc_gym.persistence import write_atomic
-from vc_gym.validation import positive_float
+from vc_gym.validation import int_at_least, positive_float
 
-__all__ = ["TrainConfig", "train"]
+__all__ = ["TrainConfig", "read_train_config", "train"]
 
 CONFIG_SCHEMA = 2
 
@@ -45,7 +48,9 @@ class TrainConfig:
     n_envs : int
         Parallel environments (one worker process each with ``vec_env="subproc"``).
     seed : int
-        Seed of the model and of the environments (env ``i`` gets ``seed + i``).
+        Seed of the model and of the environments (env ``i`` gets ``seed + i``) and of
+        the learning phase, which runs once per training run (``DIR/atlas.npz``, shared
+        by every worker; see ``atlas_file`` of ``vc_gym/LearnThenHome-v0``).
     scene : str
         Scene of ``vc_gym/LearnThenHome-v0``.
     learn_time_s, success_radius_m, max_homing_s : float
@@ -73,6 +78,16 @@ class TrainConfig:
         Turn rate (deg/s) of a full turn action.
     tracker : str
         Tracker of the agent's env (``"grid"``, ``"particle"``, ``"kalman"``).
+    eval_freq : int
+        Decisions between evaluations on held-out kidnappings (0: none). The model with
+        the best mean return is kept as ``best/best_model.zip``.
+    eval_episodes : int
+        Kidnappings per evaluation (the same ones every time).
+    eval_seed : int
+        Seed of the held-out kidnappings (training envs use ``seed + i``).
+    save_freq : int
+        Decisions between checkpoints in ``checkpoints/`` (0: none); ``--resume DIR``
+        continues from the latest.
     """
 
     algo: str = "ppo"
@@ -94,6 +109,10 @@ class TrainConfig:
     max_forward: float = 0.4
     max_turn_deg_s: float = 60.0
     tracker: str = "grid"
+    eval_freq: int = 10_000
+    eval_episodes: int = 10
+    eval_seed: int = 1_000_000
+    save_freq: int = 0
 
     def __post_init__(self) -> None:
         if self.algo not in ALGORITHMS:
@@ -102,10 +121,10 @@ class TrainConfig:
             raise ValueError(f"tracker must be a tracker name, got {self.tracker!r}")
         if self.vec_env not in ("subproc", "dummy"):
             raise ValueError(f"vec_env must be 'subproc' or 'dummy', got {self.vec_env!r}")
-        for name in ("timesteps", "n_envs", "n_steps", "batch_size"):
-            v = getattr(self, name)
-            if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
-                raise ValueError(f"{name} must be an int >= 1, got {v!r}")
+        for name in ("timesteps", "n_envs", "n_steps", "batch_size", "eval_episodes"):
+            int_at_least(name, getattr(self, name), 1)
+        for name in ("eval_freq", "eval_seed", "save_freq", "seed"):
+            int_at_least(name, getattr(self, name), 0)
         for name in (
             "learn_time_s",
             "stop_time_s",
@@ -165,80 +184,250 @@ class TrainConfig:
         return config
 
 
+def shared_place(config: TrainConfig, atlas_file: str | os.PathLike) -> dict[str, Any]:
+    """The ``vc_gym/Homing-v0`` arguments that make every training env load the place
+    learned once into ``atlas_file`` (learning seed: the run's seed)."""
+    return {"atlas_file": str(atlas_file), "learning_seed": config.seed}
+
+
+def learn_place(config: TrainConfig, atlas_file: str | os.PathLike) -> bool:
+    """Run the learning phase of ``config``'s env once, into ``atlas_file`` (kept if it is
+    there already and was learned the same way). Returns whether it learned."""
+    env = gym.make("vc_gym/Homing-v0", **config.env_kwargs(), **shared_place(config, atlas_file))
+    try:
+        env.reset(seed=config.seed)
+        return bool(env.unwrapped.learner.learned)
+    finally:
+        env.close()
+
+
+def read_train_config(path: str | os.PathLike, **overrides: Any) -> TrainConfig:
+    """A :class:`TrainConfig` from a YAML or JSON file of its fields (any subset; a
+    ``config.json`` written by :func:`train` works too), with ``overrides`` on top.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, for a file that cannot be read or an unknown or bad field.
+    """
+    data = read_settings(path)
+    data.pop("env", None)  # a config.json's derived env arguments
+    data.setdefault("schema", CONFIG_SCHEMA)
+    try:
+        return TrainConfig.from_dict({**data, **overrides})
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {exc}") from None
+
+
 class _EnvFactory:
     """Picklable env constructor for worker processes."""
 
-    def __init__(self, config: TrainConfig, rank: int):
-        self.config, self.rank = config, rank
+    def __init__(
+        self,
+        config: TrainConfig,
+        rank: int,
+        atlas_file: str | os.PathLike,
+        monitor: str | os.PathLike | None = None,
+        append: bool = False,
+    ):
+        self.config, self.rank, self.atlas_file = config, rank, atlas_file
+        self.monitor, self.append = monitor, append
 
     def __call__(self) -> gym.Env:
         from stable_baselines3.common.monitor import Monitor
 
-        env = gym.make("vc_gym/Homing-v0", **self.config.env_kwargs())
-        env = Monitor(env, info_keywords=("stop_error_m", "success"))
+        env = gym.make(
+            "vc_gym/Homing-v0",
+            **self.config.env_kwargs(),
+            **shared_place(self.config, self.atlas_file),
+        )
+        env = Monitor(
+            env,
+            filename=None if self.monitor is None else str(self.monitor),
+            info_keywords=("stop_error_m", "success"),
+            override_existing=not self.append,
+        )
         env.reset(seed=self.config.seed + self.rank)
         return env
 
 
-def train(config: TrainConfig, out_dir: str | os.PathLike, progress: bool = True) -> dict[str, Any]:
-    """Train a homing agent and write ``model.zip``, ``config.json``, ``train_log.json``
-    and ``learning_curve.png`` to ``out_dir``.
+def latest_checkpoint(run_dir: str | os.PathLike) -> Path | None:
+    """The checkpoint with the most decisions in ``run_dir/checkpoints`` (None if none)."""
+    found = []
+    for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip"):
+        steps = p.stem[len("model_") : -len("_steps")]
+        if steps.isdigit():
+            found.append((int(steps), p))
+    return max(found)[1] if found else None
+
+
+def train(
+    config: TrainConfig,
+    out_dir: str | os.PathLike,
+    progress: bool = True,
+    tensorboard_log: str | os.PathLike | None = None,
+    resume: bool = False,
+) -> dict[str, Any]:
+    """Train a homing agent the way stable-baselines3 users expect.
+
+    Writes to ``out_dir``: ``model.zip`` (the final policy), ``config.json``,
+    ``train_log.json`` (every training episode), ``learning_curve.png``, ``atlas.npz``
+    (the place, learned once), ``monitor/<i>.monitor.csv`` (SB3's per-worker episode
+    logs), with ``eval_freq`` ``eval/evaluations.npz`` and ``best/best_model.zip``
+    (held-out kidnappings), with ``save_freq`` ``checkpoints/model_<N>_steps.zip``.
+
+    Parameters
+    ----------
+    config : TrainConfig
+        The run's settings (saved as ``config.json`` before training starts).
+    out_dir : path-like
+        The run folder.
+    progress : bool
+        Show progress.
+    tensorboard_log : path-like, optional
+        Also write TensorBoard logs there (needs the ``tensorboard`` package).
+    resume : bool
+        Continue the run in ``out_dir`` from its latest checkpoint up to
+        ``config.timesteps`` decisions (its ``config.json`` must match ``config`` except
+        for ``timesteps``).
 
     Returns
     -------
     dict
-        Paths, duration, episodes seen, and the success rate and mean stop error of the
-        last 50 training episodes.
+        Paths, duration, decisions per second while the policy trained, episodes seen,
+        and the success rate and mean stop error of the last 50 training episodes.
     """
-    from stable_baselines3.common.callbacks import BaseCallback
+    import torch
+    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
-    from tqdm import tqdm
+
+    from vc_gym.experiments.training_callbacks import EpisodeLog, HeldOutEvaluation
 
     out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{out}: exists and is not a folder")
+    algo = algorithm_class(config.algo)
+    if tensorboard_log is not None:
+        try:
+            import tensorboard  # noqa: F401
+        except ImportError:
+            raise ValueError(
+                "--tensorboard-log needs the tensorboard package: pip install tensorboard"
+            ) from None
+    episodes: list[dict[str, Any]] = []
+    checkpoint = None
+    if resume:
+        checkpoint, episodes = _resume_state(out, config)
     out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "config.json", config.to_dict())
     t0 = time.perf_counter()
-    factories = [_EnvFactory(config, i) for i in range(config.n_envs)]
+    atlas_file = out / "atlas.npz"
+    if progress:
+        print(f"learning the place once ({config.scene}, seed {config.seed}) -> {atlas_file}")
+    learn_place(config, atlas_file)
+    (out / "monitor").mkdir(exist_ok=True)
+    factories = [
+        _EnvFactory(config, i, atlas_file, out / "monitor" / str(i), append=resume)
+        for i in range(config.n_envs)
+    ]
     if config.vec_env == "subproc":
         venv = SubprocVecEnv(factories, start_method="forkserver")
     else:
         venv = DummyVecEnv(factories)
-    episodes: list[dict[str, Any]] = []
-
-    class _Progress(BaseCallback):
-        def _on_training_start(self) -> None:
-            self.bar = tqdm(
-                total=config.timesteps, desc=f"train {config.algo}", disable=not progress
+    log = EpisodeLog(
+        config.timesteps,
+        episodes,
+        lambda eps: write_json(out / "train_log.json", {"running": True, "per_episode": eps}),
+        f"train {config.algo}",
+        progress,
+    )
+    callbacks: list[Any] = [log]
+    eval_env = None
+    if config.eval_freq:
+        # the task's rules, the same place; kidnappings from held-out seeds
+        eval_env = DummyVecEnv(
+            [
+                lambda: Monitor(
+                    gym.make(
+                        "vc_gym/Homing-v0",
+                        **config.env_kwargs(),
+                        **shared_place(config, atlas_file),
+                    )
+                )
+            ]
+        )
+        callbacks.append(
+            HeldOutEvaluation(
+                eval_env,
+                seed=config.eval_seed,
+                n_eval_episodes=config.eval_episodes,
+                eval_freq=max(1, config.eval_freq // config.n_envs),
+                best_model_save_path=str(out / "best"),
+                log_path=str(out / "eval"),
+                deterministic=True,
+                verbose=0,
             )
+        )
+    if config.save_freq:
+        callbacks.append(
+            CheckpointCallback(
+                max(1, config.save_freq // config.n_envs), str(out / "checkpoints"), "model"
+            )
+        )
+    # the policy is a small MLP: one torch thread is as fast, and a second one would
+    # take a core from the env workers
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        if checkpoint is not None:
+            model = algo.load(checkpoint, env=venv, device="cpu")
+            if tensorboard_log is not None:
+                model.tensorboard_log = str(tensorboard_log)
+        else:
+            model = algo("MlpPolicy", venv, tensorboard_log=tensorboard_log, **_algo_kwargs(config))
+        with warnings.catch_warnings():
+            # evaluation runs in this process (DummyVecEnv) on purpose
+            warnings.filterwarnings("ignore", "Training and eval env are not of the same type")
+            model.learn(
+                total_timesteps=max(0, config.timesteps - model.num_timesteps),
+                callback=CallbackList(callbacks),
+                reset_num_timesteps=checkpoint is None,
+                tb_log_name=config.algo,
+            )
+    finally:
+        torch.set_num_threads(threads)
+        venv.close()
+        if eval_env is not None:
+            eval_env.close()
+    model_path = out / "model.zip"
+    write_atomic(model_path, model.save)
+    recent = episodes[-50:]
+    rate = log.decisions_per_s
+    summary = {
+        "model": str(model_path),
+        "config": config.to_dict(),
+        "duration_s": round(time.perf_counter() - t0, 1),
+        # agent decisions per second while the policy trained (no learning phase, no
+        # worker start-up): what `vc-gym bench train` compares with the env's own speed
+        "decisions_per_s": None if rate is None else round(rate, 2),
+        "episodes": len(episodes),
+        "resumed_from": None if checkpoint is None else str(checkpoint),
+        "best_model": str(out / "best" / "best_model.zip")
+        if (out / "best" / "best_model.zip").is_file()
+        else None,
+        "recent_success_rate": float(np.mean([e["success"] for e in recent])) if recent else None,
+        "recent_mean_stop_error_m": float(np.nanmean([e["stop_error_m"] for e in recent]))
+        if recent
+        else None,
+    }
+    write_json(out / "train_log.json", {**summary, "per_episode": episodes})
+    if episodes:
+        _plot_curve(out / "learning_curve.png", episodes, config)
+    return summary
 
-        def _on_step(self) -> bool:
-            self.bar.update(self.training_env.num_envs)
-            for info in self.locals["infos"]:
-                ep = info.get("episode")
-                if ep is not None:
-                    episodes.append(
-                        {
-                            "timestep": int(self.num_timesteps),
-                            "return": float(ep["r"]),
-                            "decisions": int(ep["l"]),
-                            "stop_error_m": float(info.get("stop_error_m", float("nan"))),
-                            "success": bool(info.get("success", False)),
-                        }
-                    )
-                    if len(episodes) % 100 == 0:  # a log to watch while it runs
-                        write_json(
-                            out / "train_log.json", {"running": True, "per_episode": episodes}
-                        )
-                    recent = episodes[-50:]
-                    self.bar.set_postfix(
-                        success=f"{np.mean([e['success'] for e in recent]):.0%}",
-                        err=f"{np.nanmean([e['stop_error_m'] for e in recent]):.2f}m",
-                    )
-            return True
 
-        def _on_training_end(self) -> None:
-            self.bar.close()
-
-    algo = algorithm_class(config.algo)
+def _algo_kwargs(config: TrainConfig) -> dict[str, Any]:
     kwargs: dict[str, Any] = {
         "learning_rate": config.learning_rate,
         "gamma": config.gamma,
@@ -250,29 +439,33 @@ def train(config: TrainConfig, out_dir: str | os.PathLike, progress: bool = True
     }
     if config.algo == "ppo":
         kwargs["n_steps"] = config.n_steps
-    try:
-        model = algo("MlpPolicy", venv, **kwargs)
-        model.learn(total_timesteps=config.timesteps, callback=_Progress())
-    finally:
-        venv.close()
-    model_path = out / "model.zip"
-    write_atomic(model_path, model.save)
-    write_json(out / "config.json", config.to_dict())
-    recent = episodes[-50:]
-    summary = {
-        "model": str(model_path),
-        "config": config.to_dict(),
-        "duration_s": round(time.perf_counter() - t0, 1),
-        "episodes": len(episodes),
-        "recent_success_rate": float(np.mean([e["success"] for e in recent])) if recent else None,
-        "recent_mean_stop_error_m": float(np.nanmean([e["stop_error_m"] for e in recent]))
-        if recent
-        else None,
-    }
-    write_json(out / "train_log.json", {**summary, "per_episode": episodes})
-    if episodes:
-        _plot_curve(out / "learning_curve.png", episodes, config)
-    return summary
+    return kwargs
+
+
+def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, Any]]]:
+    """The checkpoint to continue from and the episodes logged so far (checked first)."""
+    saved_path = out / "config.json"
+    if not saved_path.is_file():
+        raise ValueError(f"{out}: no config.json, nothing to resume")
+    saved = read_train_config(saved_path)
+    if replace(saved, timesteps=config.timesteps) != config:
+        raise ValueError(
+            f"{saved_path}: the run was started with other settings; resume it with the "
+            "same ones (only timesteps may change)"
+        )
+    checkpoint = latest_checkpoint(out)
+    if checkpoint is None:
+        raise ValueError(f"{out}: no checkpoint to resume from (train with --save-freq N)")
+    steps = int(checkpoint.stem[len("model_") : -len("_steps")])
+    log_path = out / "train_log.json"
+    episodes: list[dict[str, Any]] = []
+    if log_path.is_file():
+        try:
+            logged = json.loads(log_path.read_text())["per_episode"]
+        except (OSError, ValueError, KeyError, TypeError, RecursionError) as exc:
+            raise ValueError(f"{log_path}: unreadable training log: {exc}") from None
+        episodes = [e for e in logged if isinstance(e, dict) and e.get("timestep", 0) <= steps]
+    return checkpoint, episodes
 
 
 def _plot_curve(path: Path, episodes: list[dict[str, Any]], config: TrainConfig) -> None:

@@ -1,0 +1,72 @@
+"""Reading settings files (JSON or YAML) safely: plain data only, bounded size and depth.
+
+A settings file may come from anyone (a colleague's hyperparameters, a downloaded run):
+reading one must never execute code (YAML is read with ``safe_load``: no Python tags),
+exhaust memory (a size limit before parsing) or crash the interpreter (deep nesting is
+refused with a clear error, not a ``RecursionError``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+__all__ = ["MAX_SETTINGS_BYTES", "MAX_SETTINGS_DEPTH", "read_settings"]
+
+#: Largest settings file read (bytes).
+MAX_SETTINGS_BYTES = 1_000_000
+#: Deepest nesting of lists and mappings accepted.
+MAX_SETTINGS_DEPTH = 20
+
+
+def _depth(value: Any, limit: int) -> int:
+    """Nesting depth of ``value``, iteratively (so a deep value cannot overflow the stack)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, dict | list):
+            if d > limit:
+                return d
+            deepest = max(deepest, d)
+            stack.extend((c, d + 1) for c in (v.values() if isinstance(v, dict) else v))
+    return deepest
+
+
+def read_settings(path: str | os.PathLike) -> dict[str, Any]:
+    """Read a JSON (``.json``) or YAML (``.yml``, ``.yaml``) file holding one mapping.
+
+    Raises
+    ------
+    ValueError
+        Naming the file: missing, too large, not UTF-8, not parseable, nested deeper than
+        :data:`MAX_SETTINGS_DEPTH`, or not a mapping with string keys.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in (".json", ".yml", ".yaml"):
+        raise ValueError(f"{p}: a settings file must be .json, .yml or .yaml")
+    try:
+        size = p.stat().st_size
+        if size > MAX_SETTINGS_BYTES:
+            raise ValueError(f"{p}: {size} bytes, more than a settings file may hold")
+        text = p.read_bytes().decode("utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{p}: cannot read the settings file: {exc}") from None
+    try:
+        if suffix == ".json":
+            data = json.loads(text)
+        else:
+            import yaml
+
+            data = yaml.safe_load(text)
+    except RecursionError:
+        raise ValueError(f"{p}: nested too deeply") from None
+    except Exception as exc:  # json.JSONDecodeError, yaml.YAMLError and their kin
+        raise ValueError(f"{p}: not valid {suffix[1:].upper()}: {exc}") from None
+    if _depth(data, MAX_SETTINGS_DEPTH) > MAX_SETTINGS_DEPTH:
+        raise ValueError(f"{p}: nested deeper than {MAX_SETTINGS_DEPTH} levels")
+    if not isinstance(data, dict) or not all(isinstance(k, str) for k in data):
+        raise ValueError(f"{p}: must hold one mapping of settings by name")
+    return data

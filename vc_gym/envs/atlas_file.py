@@ -1,0 +1,135 @@
+"""Learning phases saved to a file: learn once, load everywhere (no robot motion).
+
+The learning phase is the expensive part of the learn-then-home task (~40 s of simulation
+for the paper's four spots). Parallel training workers, evaluation jobs and repeated runs
+need the same place learned the same way, so a learner can read its result from an atlas
+file instead (:class:`SavedAtlas`), or learn it once and write it for the others
+(:class:`AtlasFile`, what ``vc_gym/LearnThenHome-v0``'s ``atlas_file=`` uses).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+from vc_gym.compass import CompassAtlas
+from vc_gym.envs.learning import Learner, LearningConfig, LearningResult
+from vc_gym.errors import MapFileError
+
+try:  # POSIX: workers that share a file wait for the first one to learn it
+    import fcntl
+except ImportError:  # pragma: no cover - Windows: each worker may learn it once
+    fcntl = None
+
+__all__ = ["AtlasFile", "SavedAtlas"]
+
+
+def _result_of(atlas: CompassAtlas, meta: Mapping[str, Any]) -> LearningResult:
+    spots = {n: tuple(map(float, p)) for n, p in zip(atlas.names, atlas.positions, strict=True)}
+    return LearningResult(
+        atlas, spots, odometry_turn_scale=float(meta.get("odometry_turn_scale", 1.0))
+    )
+
+
+class SavedAtlas:
+    """A task learner that loads a saved atlas instead of learning (no robot motion).
+
+    Parameters
+    ----------
+    path : path-like
+        An atlas written by :meth:`CompassAtlas.save`.
+    """
+
+    def __init__(self, path: str | os.PathLike):
+        self.path = Path(path)
+
+    def __repr__(self) -> str:
+        return f"SavedAtlas({str(self.path)!r})"
+
+    def __call__(self, room, config: LearningConfig) -> LearningResult:
+        atlas, meta = CompassAtlas.load_with_metadata(self.path)
+        if atlas.compasses[0].config != config.compass:
+            raise MapFileError(
+                f"{self.path}: learned with {atlas.compasses[0].config}, the task expects "
+                f"{config.compass}"
+            )
+        return _result_of(atlas, meta)
+
+
+class AtlasFile:
+    """Run ``learner`` once and keep its atlas in ``path``; later calls load the file.
+
+    The file's metadata holds ``spec`` (everything that shapes the learning: scene,
+    learning settings, learner, seed, room options); a file learned with another spec
+    is refused with a :class:`~vc_gym.errors.MapFileError` rather than silently used.
+    Processes that share ``path`` take a lock beside it (``path + ".lock"``, POSIX), so
+    one learns while the others wait and then load.
+
+    Parameters
+    ----------
+    path : path-like
+        The atlas file (``.npz``), created if missing (written atomically).
+    learner : callable
+        ``learner(room, config) -> LearningResult``, run when the file is missing.
+    spec : mapping
+        JSON values that identify the learning (compared with the file's).
+    """
+
+    def __init__(self, path: str | os.PathLike, learner: Learner, spec: Mapping[str, Any]):
+        self.path = Path(path)
+        if self.path.suffix != ".npz":
+            raise ValueError(f"atlas_file must end in .npz, got {str(self.path)!r}")
+        if self.path.is_dir():
+            raise ValueError(f"atlas_file {str(self.path)!r} is a folder")
+        if not self.path.parent.is_dir():
+            raise ValueError(f"atlas_file {str(self.path)!r}: its folder does not exist")
+        self.learner = learner
+        self.spec = json.loads(json.dumps(dict(spec), sort_keys=True))
+        self.learned = False  # whether the last call learned (True) or loaded (False)
+
+    def __repr__(self) -> str:
+        return f"AtlasFile({str(self.path)!r}, {self.learner!r})"
+
+    def _load(self) -> LearningResult:
+        atlas, meta = CompassAtlas.load_with_metadata(self.path)
+        if meta.get("spec") != self.spec:
+            raise MapFileError(
+                f"{self.path}: learned with {meta.get('spec')!r}, this task learns with "
+                f"{self.spec!r}; delete the file or choose another atlas_file"
+            )
+        return _result_of(atlas, meta)
+
+    @contextlib.contextmanager
+    def _locked(self) -> Iterator[None]:
+        if fcntl is None:  # pragma: no cover
+            yield
+            return
+        with open(self.path.with_name(self.path.name + ".lock"), "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                yield
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    def __call__(self, room, config: LearningConfig) -> LearningResult:
+        with self._locked():
+            if self.path.exists():
+                self.learned = False
+                return self._load()
+            result = self.learner(room, config)
+            if not isinstance(result, LearningResult):
+                return result  # the task env reports a learner that returns the wrong type
+            result.atlas.save(
+                self.path,
+                metadata={
+                    "spec": self.spec,
+                    "spots": {n: list(p) for n, p in result.spots.items()},
+                    "odometry_turn_scale": float(result.odometry_turn_scale),
+                },
+            )
+            self.learned = True
+            return result
