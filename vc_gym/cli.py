@@ -580,10 +580,13 @@ def build_parser() -> argparse.ArgumentParser:
             "Train PPO (default) or SAC on vc_gym/LearnThenHome-v0 wrapped in "
             "CompassObservation: the agent sees the filters' heading and position estimates "
             "and the spots' goodness (never the image or the true pose) and acts by walking, "
-            "turning and deciding to stop. Environments run in parallel worker processes "
-            "(SubprocVecEnv); each learns the place once (scripted learning) and is then "
-            "kidnapped again and again. Writes DIR/model.zip, DIR/config.json, "
-            "DIR/train_log.json and DIR/learning_curve.png."
+            "turning and deciding to stop. The place is learned once (DIR/atlas.npz) and "
+            "loaded by the environments, which run in parallel worker processes "
+            "(SubprocVecEnv) and are kidnapped again and again. Writes DIR/model.zip, "
+            "DIR/config.json, DIR/train_log.json, DIR/learning_curve.png, "
+            "DIR/monitor/<i>.monitor.csv, DIR/eval and DIR/best (held-out evaluations) and "
+            "DIR/checkpoints (--save-freq). Settings: TrainConfig's defaults, then --config "
+            "FILE, then the options given here."
         ),
     )
     # every setting defaults to None here: a value given on the command line overrides

@@ -345,7 +345,7 @@ def train(
     callbacks: list[Any] = [log]
     eval_env = None
     if config.eval_freq:
-        # the task's rules, the same place; kidnappings from held-out seeds
+        # the training env (same place, same rules), kidnapped from held-out seeds
         eval_env = DummyVecEnv(
             [
                 lambda: Monitor(
