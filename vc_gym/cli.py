@@ -617,7 +617,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--eval-freq",
         type=int,
         help="decisions between evaluations on held-out kidnappings, best model kept in "
-        "DIR/best (default 10000; 0: none)",
+        "DIR/best (default 20000; 0: none)",
     )
     p.add_argument("--eval-episodes", type=int, help="kidnappings per evaluation (default 10)")
     p.add_argument(

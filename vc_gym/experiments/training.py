@@ -109,7 +109,7 @@ class TrainConfig:
     max_forward: float = 0.4
     max_turn_deg_s: float = 60.0
     tracker: str = "grid"
-    eval_freq: int = 10_000
+    eval_freq: int = 20_000
     eval_episodes: int = 10
     eval_seed: int = 1_000_000
     save_freq: int = 0
