@@ -17,6 +17,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
+
 __all__ = ["ALGORITHMS", "ENV_KEYS", "PRETRAINED_MODEL", "LearnedHomingAgent", "algorithm_class"]
 
 ALGORITHMS = ("ppo", "sac")
@@ -85,7 +87,10 @@ class LearnedHomingAgent:
             raise ValueError(f"{cfg_path}: missing (train writes it next to the model)")
         self.algo, self.env_kwargs = read_agent_config(cfg_path)
         try:
-            self.model = algorithm_class(self.algo).load(path, device="cpu")
+            # never unpickles: a model file from anyone cannot run code here
+            self.model = load_sb3_model(self.algo, path, device="cpu")
+        except UnsafeModelError as exc:
+            raise UnsafeModelError(f"cannot load the {self.algo} model: {exc}") from None
         except Exception as exc:  # SB3 raises many kinds on a corrupt zip
             raise ValueError(f"{path}: cannot load the {self.algo} model: {exc}") from exc
         self.path = path

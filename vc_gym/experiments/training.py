@@ -21,6 +21,7 @@ import gymnasium as gym
 import numpy as np
 
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
+from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
 from vc_gym.experiments.output import new_figure, save_figure, write_json
 from vc_gym.persistence import write_atomic
@@ -381,11 +382,12 @@ def train(
     torch.set_num_threads(1)
     try:
         if checkpoint is not None:
-            model = algo.load(checkpoint, env=venv, device="cpu")
+            model = load_sb3_model(config.algo, checkpoint, env=venv, device="cpu")
             if tensorboard_log is not None:
                 model.tensorboard_log = str(tensorboard_log)
         else:
-            model = algo("MlpPolicy", venv, tensorboard_log=tensorboard_log, **_algo_kwargs(config))
+            tb = None if tensorboard_log is None else str(tensorboard_log)  # plain JSON in the zip
+            model = algo("MlpPolicy", venv, tensorboard_log=tb, **_algo_kwargs(config))
         with warnings.catch_warnings():
             # evaluation runs in this process (DummyVecEnv) on purpose
             warnings.filterwarnings("ignore", "Training and eval env are not of the same type")

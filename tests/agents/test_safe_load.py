@@ -1,0 +1,113 @@
+"""Loading a model.zip never runs code from it (no unpickling), and refuses what is not ours."""
+
+from __future__ import annotations
+
+import base64
+import json
+import pickle
+import zipfile
+
+import numpy as np
+import pytest
+
+from vc_gym.agents.learned import PRETRAINED_MODEL
+from vc_gym.agents.safe_load import MAX_ENTRY_BYTES, UnsafeModelError, load_sb3_model
+
+
+class _Payload:
+    """Unpickling this writes a marker file: proof that code from the file ran."""
+
+    def __init__(self, marker):
+        self.marker = str(marker)
+
+    def __reduce__(self):
+        return (open, (self.marker, "w"))
+
+
+def _rewrite(src, dst, edit_data=None, extra=None):
+    """Copy a model zip, editing its ``data`` JSON and adding entries."""
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for info in zin.infolist():
+            content = zin.read(info.filename)
+            if info.filename == "data" and edit_data is not None:
+                data = json.loads(content)
+                edit_data(data)
+                content = json.dumps(data).encode()
+            zout.writestr(info.filename, content)
+        for name, content in (extra or {}).items():
+            zout.writestr(name, content)
+    return dst
+
+
+def _pickled(marker):
+    return {":type:": "<class 'x'>", ":serialized:": base64.b64encode(
+        pickle.dumps(_Payload(marker))
+    ).decode()}  # fmt: skip
+
+
+def test_the_shipped_policy_loads_the_same_as_sb3_would():
+    from stable_baselines3 import PPO
+
+    safe = load_sb3_model("ppo", PRETRAINED_MODEL)
+    plain = PPO.load(PRETRAINED_MODEL, device="cpu")
+    obs = np.random.default_rng(0).uniform(-2, 2, (8, 12)).astype(np.float32)
+    np.testing.assert_array_equal(
+        safe.predict(obs, deterministic=True)[0], plain.predict(obs, deterministic=True)[0]
+    )
+    assert safe.lr_schedule(1.0) == plain.lr_schedule(1.0)
+    assert safe.clip_range(1.0) == plain.clip_range(1.0)
+
+
+@pytest.mark.parametrize("key", ["lr_schedule", "observation_space", "my_extra_object"])
+def test_a_pickled_payload_never_runs(tmp_path, key):
+    marker = tmp_path / "ran"
+
+    def plant(data):
+        if key in data:
+            data[key][":serialized:"] = _pickled(marker)[":serialized:"]
+        else:
+            data[key] = _pickled(marker)
+
+    hostile = _rewrite(PRETRAINED_MODEL, tmp_path / "model.zip", plant)
+    try:
+        load_sb3_model("ppo", hostile)  # known keys are rebuilt from their plain fields
+    except UnsafeModelError as exc:
+        assert key == "my_extra_object" and "unpickled" in str(exc)
+    assert not marker.exists()
+
+
+@pytest.mark.parametrize(
+    ("edit", "extra", "message"),
+    [
+        (
+            lambda d: d["lr_schedule"].update(value_schedule="LinearSchedule(1, 0)"),
+            None,
+            "constant",
+        ),
+        (lambda d: d["observation_space"].update(high="[5. 5.]"), None, "bounds"),
+        (lambda d: d["action_space"].update(_shape=[7]), None, "Box"),
+        (None, {"evil.py": b"import os"}, "unexpected entries"),
+        (None, {"data": b"{}"}, "twice"),  # a second 'data' entry hiding behind the first
+    ],
+)
+@pytest.mark.filterwarnings("ignore:Duplicate name")
+def test_files_that_are_not_our_agents_are_refused(tmp_path, edit, extra, message):
+    bad = _rewrite(PRETRAINED_MODEL, tmp_path / "model.zip", edit, extra)
+    with pytest.raises(UnsafeModelError, match=message) as err:
+        load_sb3_model("ppo", bad)
+    assert str(bad) in str(err.value)
+
+
+def test_huge_and_garbage_files_are_refused(tmp_path):
+    big = tmp_path / "big.zip"
+    with zipfile.ZipFile(big, "w", compression=zipfile.ZIP_DEFLATED) as z:
+        z.writestr("data", "{}")
+        z.writestr("policy.pth", b"\0" * (MAX_ENTRY_BYTES + 1))  # compresses to ~60 kB
+    with pytest.raises(UnsafeModelError, match="larger"):
+        load_sb3_model("ppo", big)
+    junk = tmp_path / "junk.zip"
+    junk.write_bytes(b"not a zip")
+    with pytest.raises(UnsafeModelError, match="readable"):
+        load_sb3_model("ppo", junk)
+    with pytest.raises(ValueError, match="algo"):
+        load_sb3_model("dqn", PRETRAINED_MODEL)
