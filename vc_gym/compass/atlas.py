@@ -150,7 +150,13 @@ class CompassAtlas:
         ``spots`` (indices into :attr:`names`) scores only those spots' maps, in that
         order; each equals its entry of the full answer bit for bit.
         """
-        which = self._spot_indices(spots)
+        return self._scores_of(image, camera, self._spot_indices(spots), every=spots is None)
+
+    def _scores_of(
+        self, image: np.ndarray, camera: Camera, which: np.ndarray, every: bool
+    ) -> tuple[np.ndarray, list[CompassEstimate]]:
+        """:meth:`scores` of the checked spot indices ``which`` (``every``: all of them,
+        in order, so the stacked tables are read whole)."""
         compasses = [self.compasses[k] for k in which]
         first = compasses[0]
         if all(vc.colors is first.colors for vc in self.compasses):
@@ -160,7 +166,7 @@ class CompassAtlas:
                 vc._checked(image, camera, need_map=True)
             features = first._sector_features(image, camera)
             delta_t, base = self._stacked_tables()
-            maps = None if spots is None else which
+            maps = None if every else which
             lls = _log_likelihoods_of(first.config, *features, delta_t, base, maps)
             ests = _estimates_of(compasses, *features, lls)
         else:
@@ -250,7 +256,10 @@ class CompassAtlas:
     ) -> np.ndarray:
         """Home score of each spot at the given per-spot headings (0 before normalize);
         ``spots`` as in :meth:`scores`."""
-        which = self._spot_indices(spots)
+        return self._home_scores_of(headings_deg, self._spot_indices(spots))
+
+    def _home_scores_of(self, headings_deg: np.ndarray, which: np.ndarray) -> np.ndarray:
+        """:meth:`home_scores` of the checked spot indices ``which``."""
         if not self.is_normalized:
             return np.zeros(which.size)
         home_headings = self._home_headings[:, which]
@@ -278,8 +287,8 @@ class CompassAtlas:
             ]
             raise NotLearnedError(f"spots without a learned map: {missing}")
         which = self._spot_indices(spots)
-        raw, ests = self.scores(image, camera, spots)
-        rel = raw - self.home_scores(np.array([e.heading_deg for e in ests]), spots)
+        raw, ests = self._scores_of(image, camera, which, every=spots is None)
+        rel = raw - self._home_scores_of(np.array([e.heading_deg for e in ests]), which)
         logw = self.sharpness * rel
         w = np.exp(logw - logw.max())
         w /= w.sum()

@@ -17,17 +17,16 @@ import time
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.experiments.training import TrainConfig, learn_place, shared_place, train
+from vc_gym.experiments.training import TrainConfig, learn_place, train, training_env
 
 __all__ = ["bench_train"]
 
 
 def _env_rate(config: TrainConfig, atlas_file: Path, steps: int, seed: int) -> float:
-    env = gym.make("vc_gym/Homing-v0", **config.env_kwargs(), **shared_place(config, atlas_file))
+    env = training_env(config, atlas_file)
     rng = np.random.default_rng(seed)
     try:
         env.reset(seed=seed)

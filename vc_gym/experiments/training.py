@@ -24,6 +24,7 @@ from vc_gym.agents.learned import ALGORITHMS, algorithm_class
 from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
 from vc_gym.experiments.output import new_figure, save_figure, write_json
+from vc_gym.experiments.runner import check_out_dir
 from vc_gym.persistence import write_atomic
 from vc_gym.validation import int_at_least, positive_float
 
@@ -185,16 +186,21 @@ class TrainConfig:
         return config
 
 
-def shared_place(config: TrainConfig, atlas_file: str | os.PathLike) -> dict[str, Any]:
-    """The ``vc_gym/Homing-v0`` arguments that make every training env load the place
-    learned once into ``atlas_file`` (learning seed: the run's seed)."""
-    return {"atlas_file": str(atlas_file), "learning_seed": config.seed}
+def training_env(config: TrainConfig, atlas_file: str | os.PathLike) -> gym.Env:
+    """``vc_gym/Homing-v0`` as ``config`` trains on it, loading the place learned once
+    into ``atlas_file`` (learning seed: the run's seed; the first env learns it)."""
+    return gym.make(
+        "vc_gym/Homing-v0",
+        **config.env_kwargs(),
+        atlas_file=str(atlas_file),
+        learning_seed=config.seed,
+    )
 
 
 def learn_place(config: TrainConfig, atlas_file: str | os.PathLike) -> bool:
     """Run the learning phase of ``config``'s env once, into ``atlas_file`` (kept if it is
     there already and was learned the same way). Returns whether it learned."""
-    env = gym.make("vc_gym/Homing-v0", **config.env_kwargs(), **shared_place(config, atlas_file))
+    env = training_env(config, atlas_file)
     try:
         env.reset(seed=config.seed)
         return bool(env.unwrapped.learner.learned)
@@ -237,13 +243,8 @@ class _EnvFactory:
     def __call__(self) -> gym.Env:
         from stable_baselines3.common.monitor import Monitor
 
-        env = gym.make(
-            "vc_gym/Homing-v0",
-            **self.config.env_kwargs(),
-            **shared_place(self.config, self.atlas_file),
-        )
         env = Monitor(
-            env,
+            training_env(self.config, self.atlas_file),
             filename=None if self.monitor is None else str(self.monitor),
             info_keywords=("stop_error_m", "success"),
             override_existing=not self.append,
@@ -252,13 +253,19 @@ class _EnvFactory:
         return env
 
 
+def _checkpoint_steps(path: Path) -> int | None:
+    """Decisions of a ``model_<N>_steps.zip`` checkpoint (None for another name)."""
+    steps = path.stem[len("model_") : -len("_steps")]
+    return int(steps) if steps.isdigit() else None
+
+
 def latest_checkpoint(run_dir: str | os.PathLike) -> Path | None:
     """The checkpoint with the most decisions in ``run_dir/checkpoints`` (None if none)."""
-    found = []
-    for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip"):
-        steps = p.stem[len("model_") : -len("_steps")]
-        if steps.isdigit():
-            found.append((int(steps), p))
+    found = [
+        (steps, p)
+        for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
+        if (steps := _checkpoint_steps(p)) is not None
+    ]
     return max(found)[1] if found else None
 
 
@@ -306,8 +313,6 @@ def train(
     from vc_gym.experiments.training_callbacks import EpisodeLog, HeldOutEvaluation
 
     out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"{out}: exists and is not a folder")
     algo = algorithm_class(config.algo)
     if tensorboard_log is not None:
         try:
@@ -320,7 +325,7 @@ def train(
     checkpoint = None
     if resume:
         checkpoint, episodes = _resume_state(out, config)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_out_dir(out)
     write_json(out / "config.json", config.to_dict())
     t0 = time.perf_counter()
     atlas_file = out / "atlas.npz"
@@ -347,17 +352,7 @@ def train(
     eval_env = None
     if config.eval_freq:
         # the training env (same place, same rules), kidnapped from held-out seeds
-        eval_env = DummyVecEnv(
-            [
-                lambda: Monitor(
-                    gym.make(
-                        "vc_gym/Homing-v0",
-                        **config.env_kwargs(),
-                        **shared_place(config, atlas_file),
-                    )
-                )
-            ]
-        )
+        eval_env = DummyVecEnv([lambda: Monitor(training_env(config, atlas_file))])
         callbacks.append(
             HeldOutEvaluation(
                 eval_env,
@@ -380,13 +375,13 @@ def train(
     # take a core from the env workers
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
+    tb = None if tensorboard_log is None else str(tensorboard_log)  # a str: plain JSON in the zip
     try:
         if checkpoint is not None:
             model = load_sb3_model(config.algo, checkpoint, env=venv, device="cpu")
-            if tensorboard_log is not None:
-                model.tensorboard_log = str(tensorboard_log)
+            if tb is not None:
+                model.tensorboard_log = tb
         else:
-            tb = None if tensorboard_log is None else str(tensorboard_log)  # plain JSON in the zip
             model = algo("MlpPolicy", venv, tensorboard_log=tb, **_algo_kwargs(config))
         with warnings.catch_warnings():
             # evaluation runs in this process (DummyVecEnv) on purpose
@@ -458,7 +453,7 @@ def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, 
     checkpoint = latest_checkpoint(out)
     if checkpoint is None:
         raise ValueError(f"{out}: no checkpoint to resume from (train with --save-freq N)")
-    steps = int(checkpoint.stem[len("model_") : -len("_steps")])
+    steps = _checkpoint_steps(checkpoint)
     log_path = out / "train_log.json"
     episodes: list[dict[str, Any]] = []
     if log_path.is_file():
