@@ -21,6 +21,7 @@ import numpy as np
 
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.experiments.training import TrainConfig, learn_place, train, training_env
+from vc_gym.validation import int_at_least
 
 __all__ = ["bench_train"]
 
@@ -70,6 +71,7 @@ def bench_train(
         ``env_decisions_per_s``, ``train_decisions_per_s``, ``n_envs``, ``efficiency``
         and the settings.
     """
+    int_at_least("env_steps", env_steps, 1)
     config = TrainConfig(timesteps=timesteps, n_envs=n_envs, seed=seed, learn_time_s=learn_time_s)
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
         atlas_file = Path(tmp) / "atlas.npz"
