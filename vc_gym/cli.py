@@ -60,6 +60,7 @@ _TRAIN_FIELDS = {
     "eval_freq": "eval_freq",
     "eval_episodes": "eval_episodes",
     "save_freq": "save_freq",
+    "demo_episodes": "demo_episodes",
 }
 
 
@@ -625,6 +626,14 @@ def build_parser() -> argparse.ArgumentParser:
         type=int,
         help="decisions between checkpoints in DIR/checkpoints (default 0: none)",
     )
+    p.add_argument(
+        "--demo-episodes",
+        type=int,
+        metavar="N",
+        help="warm start (ppo): clone the scripted expert's decisions in N homing episodes "
+        "before PPO starts (DIR/warm_start.json; the clone is evaluated first); 0: from "
+        "scratch (default 0)",
+    )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(
         "--resume",
@@ -746,7 +755,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--agent",
         metavar="scripted|pretrained|DIR/model.zip",
-        help="homing, trackers: the agent (default scripted)",
+        help="homing, trackers: the agent (default scripted); agents: the agents to compare, "
+        "comma-separated, scripted among them (default scripted,pretrained)",
     )
     p.add_argument(
         "--tracker",

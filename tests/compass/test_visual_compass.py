@@ -342,3 +342,34 @@ def test_save_is_atomic_and_keeps_old_file_on_failure(tmp_path, room_compass, mo
         room_compass.save(path)
     assert path.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["map.npz"]
+
+
+def test_merging_maps_equals_learning_all_their_frames(room_pano):
+    fit = [render_view(room_pano, Camera(yaw_deg=a)) for a in range(0, 360, 45)]
+    whole, first = VisualCompass(), VisualCompass()
+    whole.fit_colors(fit)
+    first.fit_colors(fit)
+    second = VisualCompass(colors=first.colors)
+    yaws = np.arange(0.0, 360.0, 20.0)
+    for k, yaw in enumerate(yaws):
+        image, cam = render_view(room_pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw)
+        whole.learn(image, cam)
+        (first if k % 2 else second).learn(image, cam)
+    assert first.merge(second) is first
+    assert first.frames_learned == whole.frames_learned == len(yaws)
+    np.testing.assert_array_equal(first.sector_observations, whole.sector_observations)
+    probe = render_view(room_pano, Camera(yaw_deg=123.0))
+    np.testing.assert_array_equal(
+        first.log_likelihood(probe, Camera()), whole.log_likelihood(probe, Camera())
+    )
+
+
+def test_merge_refuses_other_configs_or_colours(room_pano, room_compass):
+    with pytest.raises(ValueError, match="CompassConfig"):
+        VisualCompass(CompassConfig(n_colors=3)).merge(room_compass)
+    other = VisualCompass()
+    other.fit_colors([render_view(room_pano, Camera(yaw_deg=a)) for a in (10.0, 200.0)])
+    with pytest.raises(ValueError, match="colour classes"):
+        other.merge(room_compass)
+    with pytest.raises(ValueError, match="VisualCompass"):
+        other.merge("map.npz")

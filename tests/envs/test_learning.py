@@ -154,6 +154,29 @@ def test_grid_learning_shares_colours_and_knows_each_spot():
     env.close()
 
 
+def test_grid_learning_around_each_spot_adds_four_turns_to_its_map():
+    env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+    room = env.unwrapped
+    room.reset(seed=0)
+    config = LearningConfig(learn_time_s=0.5)
+    plain = GridLearning([(0.0, 0.0)])(room, config)
+    result = GridLearning([(0.0, 0.0)], around_m=0.4, around_steps=2)(room, config)
+    env.close()
+    steps = 5  # 0.5 s at 0.1 s per step
+    assert len(result.true_path) == 8 * steps + 4 * 8 * 2
+    places = {(round(p[0], 1), round(p[1], 1)) for p in result.true_path}
+    assert {(0.4, 0.0), (-0.4, 0.0), (0.0, 0.4), (0.0, -0.4)} <= places
+    vc, spot_only = result.atlas.compasses[0], plain.atlas.compasses[0]
+    assert vc.frames_learned == spot_only.frames_learned + 4 * 8 * 2
+    assert "around_m=0.4" in repr(GridLearning([(0.0, 0.0)], around_m=0.4))
+
+
+@pytest.mark.parametrize("kwargs", [{"around_m": -0.1}, {"around_m": np.nan}, {"around_steps": 0}])
+def test_grid_learning_rejects_bad_around_settings(kwargs):
+    with pytest.raises(ValueError, match="around"):
+        GridLearning([(0.0, 0.0)], **kwargs)
+
+
 @pytest.mark.parametrize("bad", [[], [(0.0, 0.0), (0.0, 0.0)], [(1.0,)], "ab", [(0.0, np.inf)]])
 def test_grid_learning_rejects_bad_spots(bad):
     with pytest.raises(ValueError, match="spots"):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -186,11 +187,24 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
         {"net_arch": (0,)},
         {"vec_env": "ray"},
         {"learning_rate": float("nan")},
+        {"demo_episodes": -1},
+        {"algo": "sac", "demo_episodes": 5},
     ],
 )
 def test_bad_train_config(kwargs):
     with pytest.raises(ValueError):
         TrainConfig(**kwargs)
+
+
+def test_warm_start_clones_the_expert_and_is_evaluated_before_ppo(tmp_path):
+    config = replace(TINY, demo_episodes=2, save_freq=0, vec_env="dummy")
+    summary = train(config, tmp_path, progress=False)
+    warm = json.loads((tmp_path / "warm_start.json").read_text())
+    assert warm == summary["warm_start"]
+    assert warm["demo_episodes"] == 2 and warm["demo_decisions"] >= 2 * 20  # >= min walk each
+    assert np.isfinite(warm["action_mse"]) and np.isfinite(warm["value_mse"])
+    with np.load(tmp_path / "eval" / "evaluations.npz") as ev:
+        assert list(ev["timesteps"]) == [0, 32, 64]  # the clone, then PPO's evaluations
 
 
 def test_config_file_round_trip_and_errors(tmp_path):
@@ -223,3 +237,29 @@ def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
     assert main(argv) == 0  # resumed: nothing trained again, the same figures
     assert (out / "results.json").read_bytes() == before
     assert main([*argv[:-1], "--seed", "3"]) == 2
+
+
+def test_agents_experiment_compares_on_the_same_kidnappings(trained, tmp_path, capsys):
+    out, _ = trained
+    model = str(out / "model.zip")
+    code = main(
+        ["experiment", "agents", "--quick", "--agent", f"scripted,{model}", "--out",
+         str(tmp_path / "cmp"), "--episodes", "2", "--max-homing", "4"]
+    )  # fmt: skip
+    assert code == 0
+    res = json.loads((tmp_path / "cmp" / "results.json").read_text())
+    label = out.name
+    assert list(res["agents"]) == ["scripted", label]
+    assert res["agents"]["scripted"]["episodes"] == res["agents"][label]["episodes"] == 2
+    starts = [
+        [e["start_pose"] for e in json.loads((tmp_path / "cmp" / a / "results.json").read_text())[
+            "per_episode"]]
+        for a in ("scripted", label)
+    ]  # fmt: skip
+    assert starts[0] == starts[1]  # the same kidnappings
+    assert res["paired_with_scripted"][label]["episodes"] == 2
+    assert res["learned_over_agents"]["agents"] == 1
+    assert (tmp_path / "cmp" / "agents.png").read_bytes()[:4] == b"\x89PNG"
+    assert f"{label} vs scripted" in capsys.readouterr().out
+    bad = ["experiment", "agents", "--quick", "--agent", model, "--out", str(tmp_path / "x")]
+    assert main(bad) == 2 and "'scripted'" in capsys.readouterr().err

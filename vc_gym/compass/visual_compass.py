@@ -381,6 +381,36 @@ class VisualCompass:
         self._tables = None
         return int(seen.size)
 
+    def merge(self, other: VisualCompass) -> VisualCompass:
+        """Add the map of ``other`` to this one (in place; returns ``self``).
+
+        A map is counts (eq. 6), so the map learned from two sets of frames is the sum of
+        their maps: merging the turns learned at several places near a spot gives the map
+        of all their frames. Both compasses must share the config and the colour classes
+        (learn the second with the first's :attr:`colors`).
+
+        Raises
+        ------
+        ValueError
+            If the configs or colour classes differ, or ``other`` is not a compass.
+        """
+        if not isinstance(other, VisualCompass):
+            raise ValueError(f"can only merge a VisualCompass, got {type(other).__name__}")
+        if other.config != self.config:
+            raise ValueError("cannot merge maps learned with different CompassConfigs")
+        if (
+            self._colors is None
+            or other._colors is None
+            or not _same_colors(self._colors, other._colors)
+        ):
+            raise ValueError("cannot merge maps learned with different colour classes")
+        self._counts += other._counts
+        self._n_obs += other._n_obs
+        self._frames += other._frames
+        self._sizes |= other._sizes
+        self._tables = None
+        return self
+
     # ------------------------------------------------------------------ likelihood
     def _log_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(delta_t, base, log_abs)`` for the current map (cached until it changes).
@@ -712,3 +742,10 @@ def _scores_at(
             scores[k] = float(log_abs[sectors[:, None], pairs, bins].mean())
             used[k] = int(seen.size)
     return scores, used
+
+
+def _same_colors(a: ColorClasses, b: ColorClasses) -> bool:
+    if a is b:
+        return True
+    x, y = a.to_arrays(), b.to_arrays()
+    return x.keys() == y.keys() and all(np.array_equal(x[k], y[k]) for k in x)

@@ -30,7 +30,17 @@ class HomingFeatures(gym.ObservationWrapper):
 
     ``[home_vector / 2 m (2), cos θ̂, sin θ̂, heading spread / 180°, position / 2 m (2),
     log goodness / 5 (one per spot, clipped to ±5), head pan / 90°]``: all of order 1.
+    The class attributes name the slices and scales (what an agent reading the vector
+    uses instead of bare indices).
     """
+
+    HOME_VECTOR = slice(0, 2)
+    HEADING = slice(2, 4)
+    SPREAD = 4
+    POSITION = slice(5, 7)
+    GOODNESS_START = 7
+    METRES_SCALE = 2.0
+    SPREAD_SCALE_DEG = 180.0
 
     def __init__(self, env: gym.Env):
         super().__init__(env)
@@ -46,10 +56,10 @@ class HomingFeatures(gym.ObservationWrapper):
         g = np.log(np.maximum(obs["goodness"].astype(np.float64), 1e-12)) / 5.0
         f = np.concatenate(
             [
-                obs["home_vector"] / 2.0,
+                obs["home_vector"] / self.METRES_SCALE,
                 obs["heading"],
-                obs["heading_spread"] / 180.0,
-                obs["position"] / 2.0,
+                obs["heading_spread"] / self.SPREAD_SCALE_DEG,
+                obs["position"] / self.METRES_SCALE,
                 np.clip(g, -5.0, 5.0),
                 obs["head"][:1] / 90.0,
             ]

@@ -26,7 +26,7 @@ from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
-from vc_gym.validation import finite_float, positive_float
+from vc_gym.validation import finite_float, nonnegative_float, positive_float
 
 __all__ = [
     "HEAD_SCAN_DEG",
@@ -227,7 +227,7 @@ class ScriptedLearner:
         d = self.config.spot_distance_m
         return {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
 
-    def _steps_per_direction(self) -> int:
+    def steps_per_direction(self) -> int:
         """Frames learned per direction: ``learn_time_s`` at the room's control rate."""
         return max(1, int(round(self.config.learn_time_s / self.dt)))
 
@@ -273,7 +273,7 @@ class ScriptedLearner:
         if colors is not None and not isinstance(colors, ColorClasses):
             raise ValueError(f"colors must be ColorClasses, got {type(colors).__name__}")
         if steps is None:
-            steps = self._steps_per_direction()
+            steps = self.steps_per_direction()
         elif isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
             raise ValueError(f"steps must be an int >= 1, got {steps!r}")
         self.belief = np.zeros(3)
@@ -305,7 +305,7 @@ class ScriptedLearner:
             If the robot falls (only with ``locomotion="dynamic"``).
         """
         cfg = self.config
-        steps = self._steps_per_direction()
+        steps = self.steps_per_direction()
         spots = self.spots()
         path: list[tuple[float, float, float]] = []
         self.learn_turn(steps)
@@ -489,16 +489,29 @@ class GridLearning:
     5.2) makes every spot fit equally well *there*, so the map that fits best could no
     longer be told at that spot.
 
+    Beyond the paper, ``around_m > 0`` also learns a full turn at the four points
+    ``around_m`` east, west, north and south of every spot (``around_steps`` frames per
+    direction) and adds them to the spot's map (:meth:`VisualCompass.merge`). The map
+    then holds how the view changes within ``around_m`` of its spot, so it still fits,
+    with the right heading, a robot that stands between spots: over the robolab field
+    the heading error from the best-fitting map fell by about a third with 0.5 m
+    (``vc-gym experiment orientation --modes improved``).
+
     Parameters
     ----------
     spots : sequence of (x, y)
         The training spots, world metres; the first is home. At most 64.
+    around_m : float
+        Distance of the four extra turns around each spot (0: the paper's one turn).
+    around_steps : int, optional
+        Frames per direction of each extra turn; default a quarter of the spot's own
+        (so the four extra turns together take as long as the spot's).
     """
 
     #: Spot names are this prefix and the spot's index.
     prefix = "spot"
 
-    def __init__(self, spots):
+    def __init__(self, spots, around_m: float = 0.0, around_steps: int | None = None):
         try:
             pts = [(finite_float("spot x", x), finite_float("spot y", y)) for x, y in spots]
         except (TypeError, ValueError):
@@ -506,9 +519,24 @@ class GridLearning:
         if not 1 <= len(pts) <= 64 or len(set(pts)) != len(pts):
             raise ValueError(f"spots must be 1 to 64 distinct (x, y) pairs, got {len(pts)}")
         self.spots = pts
+        self.around_m = nonnegative_float("around_m", around_m)
+        if around_steps is not None and (
+            isinstance(around_steps, bool)
+            or not isinstance(around_steps, (int, np.integer))
+            or around_steps < 1
+        ):
+            raise ValueError(f"around_steps must be an int >= 1 or None, got {around_steps!r}")
+        self.around_steps = None if around_steps is None else int(around_steps)
 
     def __repr__(self) -> str:
-        return f"GridLearning(spots={self.spots})"
+        extra = f", around_m={self.around_m}" if self.around_m else ""
+        return f"GridLearning(spots={self.spots}{extra})"
+
+    def _around(self, spot: tuple[float, float]) -> list[tuple[float, float]]:
+        if not self.around_m:
+            return []
+        x, y, r = *spot, self.around_m
+        return [(x + r, y), (x - r, y), (x, y + r), (x, y - r)]
 
     def __call__(self, room, config: LearningConfig) -> LearningResult:
         """Learn every spot on ``room`` (``AiboRoomEnv``, unwrapped) with ``config``.
@@ -533,8 +561,13 @@ class GridLearning:
             compass = learner.learn_turn(colors=colors)
             if colors is None:
                 colors, scale = compass.colors, learner.rot_scale
-            maps[f"{self.prefix}{i}"] = (spot, compass)
             path.extend(learner.turn_path)
+            steps = self.around_steps or max(1, learner.steps_per_direction() // 4)
+            for place in self._around(spot):
+                room.reset(options={"pose": (*place, 0.0)})
+                compass.merge(learner.learn_turn(steps, colors=colors))
+                path.extend(learner.turn_path)
+            maps[f"{self.prefix}{i}"] = (spot, compass)
         atlas = CompassAtlas(maps, home=f"{self.prefix}0")
         names = {n: p for n, (p, _) in maps.items()}
         return LearningResult(atlas, names, path, scale)

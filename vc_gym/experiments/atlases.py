@@ -43,6 +43,7 @@ def atlas_spec(
     room: Mapping[str, Any] | None = None,
     learning: Mapping[str, Any] | None = None,
     spots: Sequence[Sequence[float]] | None = None,
+    around_m: float = 0.0,
 ) -> dict[str, Any]:
     """What identifies a learned atlas (a JSON dict; see :func:`learn_atlas_job`).
 
@@ -69,6 +70,9 @@ def atlas_spec(
         (``{"normalise_at": "start"}``).
     spots : sequence of (x, y), optional
         The spots of the ``"grid"`` learner, the first one home.
+    around_m : float
+        The ``"grid"`` learner's extra turns around each spot (``GridLearning``'s
+        ``around_m``; 0: none).
     """
     if learner not in LEARNERS:
         raise ValueError(f"learner must be one of {LEARNERS}, got {learner!r}")
@@ -76,8 +80,11 @@ def atlas_spec(
         raise ValueError("spot is needed by, and only by, the 'spot' learner")
     if (learner == "grid") != (spots is not None):
         raise ValueError("spots are needed by, and only by, the 'grid' learner")
+    if around_m and learner != "grid":
+        raise ValueError("around_m belongs to the 'grid' learner")
     if spots is not None:
-        spots = [[float(x), float(y)] for x, y in GridLearning(spots).spots]
+        grid = GridLearning(spots, around_m)
+        spots, around_m = [[float(x), float(y)] for x, y in grid.spots], grid.around_m
     config = CompassConfig(**dict(compass or {}))  # validates the fields
     learning = dict(learning or {})
     unknown = set(learning) - {"normalise_at"}
@@ -96,6 +103,8 @@ def atlas_spec(
         spec["spot"] = [float(v) for v in spot]
     if spots is not None:
         spec["spots"] = spots
+    if around_m:  # only when set: earlier grid specs keep their keys
+        spec["around_m"] = float(around_m)
     if learning:  # only when set: the paper's specs keep their keys
         spec["learning"] = learning
     json.dumps(spec, allow_nan=False)  # JSON values only
@@ -112,7 +121,7 @@ def _learner(spec: Mapping[str, Any]):
     if spec["learner"] == "spot":
         return SpotLearning(tuple(spec["spot"]))
     if spec["learner"] == "grid":
-        return GridLearning([tuple(p) for p in spec["spots"]])
+        return GridLearning([tuple(p) for p in spec["spots"]], spec.get("around_m", 0.0))
     return None  # the task's default: the paper's scripted learning
 
 

@@ -20,9 +20,11 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
 from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
+from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import new_figure, save_figure, write_json
 from vc_gym.experiments.runner import check_out_dir
 from vc_gym.persistence import write_atomic
@@ -90,6 +92,12 @@ class TrainConfig:
     save_freq : int
         Decisions between checkpoints in ``checkpoints/`` (0: none); ``--resume DIR``
         continues from the latest.
+    demo_episodes : int
+        Warm start (PPO only): episodes of the scripted expert
+        (:class:`~vc_gym.agents.HomingFeatureExpert`) whose decisions the policy is
+        cloned from before PPO starts (:mod:`vc_gym.experiments.imitation`); 0: PPO
+        from scratch. They are not counted in ``timesteps``. With evaluations on, the
+        clone is evaluated before PPO starts, so the best model can be the clone.
     """
 
     algo: str = "ppo"
@@ -115,6 +123,7 @@ class TrainConfig:
     eval_episodes: int = 10
     eval_seed: int = 1_000_000
     save_freq: int = 0
+    demo_episodes: int = 0
 
     def __post_init__(self) -> None:
         if self.algo not in ALGORITHMS:
@@ -125,7 +134,7 @@ class TrainConfig:
             raise ValueError(f"vec_env must be 'subproc' or 'dummy', got {self.vec_env!r}")
         for name in ("timesteps", "n_envs", "n_steps", "batch_size", "eval_episodes"):
             int_at_least(name, getattr(self, name), 1)
-        for name in ("eval_freq", "eval_seed", "save_freq", "seed"):
+        for name in ("eval_freq", "eval_seed", "save_freq", "seed", "demo_episodes"):
             int_at_least(name, getattr(self, name), 0)
         for name in (
             "learn_time_s",
@@ -138,6 +147,8 @@ class TrainConfig:
         ):
             v = getattr(self, name)
             positive_float(name, v)
+        if self.demo_episodes and self.algo != "ppo":
+            raise ValueError("demo_episodes (the warm start) needs algo 'ppo'")
         if not (0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
         if not self.net_arch or any(int(n) < 1 for n in self.net_arch):
@@ -323,6 +334,7 @@ def train(
             ) from None
     episodes: list[dict[str, Any]] = []
     checkpoint = None
+    warm_start: dict[str, Any] | None = None
     if resume:
         checkpoint, episodes = _resume_state(out, config)
     out = check_out_dir(out)
@@ -357,6 +369,7 @@ def train(
             HeldOutEvaluation(
                 eval_env,
                 seed=config.eval_seed,
+                at_start=bool(config.demo_episodes) and checkpoint is None,
                 n_eval_episodes=config.eval_episodes,
                 eval_freq=max(1, config.eval_freq // config.n_envs),
                 best_model_save_path=str(out / "best"),
@@ -383,6 +396,9 @@ def train(
                 model.tensorboard_log = tb
         else:
             model = algo("MlpPolicy", venv, tensorboard_log=tb, **_algo_kwargs(config))
+            if config.demo_episodes:
+                warm_start = _warm_start(model, venv, config, progress)
+                write_json(out / "warm_start.json", warm_start)
         with warnings.catch_warnings():
             # evaluation runs in this process (DummyVecEnv) on purpose
             warnings.filterwarnings("ignore", "Training and eval env are not of the same type")
@@ -410,6 +426,7 @@ def train(
         "decisions_per_s": None if rate is None else round(rate, 2),
         "episodes": len(episodes),
         "resumed_from": None if checkpoint is None else str(checkpoint),
+        "warm_start": warm_start,
         "best_model": str(out / "best" / "best_model.zip")
         if (out / "best" / "best_model.zip").is_file()
         else None,
@@ -422,6 +439,21 @@ def train(
     if episodes:
         _plot_curve(out / "learning_curve.png", episodes, config)
     return summary
+
+
+def _warm_start(model: Any, venv: Any, config: TrainConfig, progress: bool) -> dict[str, Any]:
+    """Clone the scripted expert into ``model``'s policy (see :mod:`.imitation`)."""
+    expert = HomingFeatureExpert(config.max_forward, config.max_turn_deg_s)
+    demos = collect_demonstrations(venv, expert, config.demo_episodes, config.gamma, progress)
+    fit = clone_behaviour(model.policy, demos, seed=config.seed)
+    errors = [e["stop_error_m"] for e in demos.episodes]
+    return {
+        "demo_episodes": len(demos.episodes),
+        "demo_decisions": len(demos.actions),
+        "demo_success_rate": demos.success_rate,
+        "demo_mean_stop_error_m": float(np.nanmean(errors)),
+        **fit,
+    }
 
 
 def _algo_kwargs(config: TrainConfig) -> dict[str, Any]:

@@ -96,12 +96,20 @@ class HeldOutEvaluation(EvalCallback):
 
     The evaluation env is reseeded with ``seed`` before each evaluation, so every
     evaluation (and the best model it keeps) is judged on one fixed set of held-out
-    kidnappings, not on whichever the env happened to draw next.
+    kidnappings, not on whichever the env happened to draw next. With ``at_start`` it
+    also evaluates once before training.
     """
 
-    def __init__(self, *args: Any, seed: int, **kwargs: Any):
+    def __init__(self, *args: Any, seed: int, at_start: bool = False, **kwargs: Any):
         super().__init__(*args, **kwargs)
         self.seed = int(seed)
+        self.at_start = bool(at_start)
+
+    def _on_training_start(self) -> None:
+        # with ``at_start`` the policy is also judged before it trains (a warm-started
+        # clone may be the best model); ``n_calls`` is 0 here, a multiple of any period
+        if self.at_start and self.eval_freq > 0:
+            self._on_step()
 
     def _on_step(self) -> bool:
         if self.eval_freq > 0 and self.n_calls % self.eval_freq == 0:

@@ -51,6 +51,13 @@ EXPERIMENTS: dict[str, Experiment] = {
             "the likelihood field of one spot over a 50 cm grid",
         ),
         Experiment(
+            "agents",
+            _P + "agents",
+            "learned agents against the scripted one: the homing experiment for every "
+            "--agent scripted,DIR/model.zip,... on the same learning seeds and kidnappings; "
+            "each agent's figures, the learned agents' mean ± std and a paired comparison",
+        ),
+        Experiment(
             "orientation",
             _P + "orientation",
             "5.1, fig. 4: learn one spot (centre of the rear field half), heading error and "

@@ -103,6 +103,9 @@ MODE_TRACKER_OPTIONS: dict[str, dict[str, Any]] = {
 #: Spacing of the improved mode's grid of spots (metres) and its margin inside the field.
 GRID_SPACING_M = 1.5
 GRID_MARGIN_M = 0.5
+#: The improved mode's maps also learn four turns this far around each spot
+#: (:class:`~vc_gym.envs.learning.GridLearning`'s ``around_m``).
+GRID_AROUND_M = 0.5
 
 
 def training_spots(bounds: Sequence[float], mode: str = "paper") -> list[tuple[float, float]]:
@@ -377,7 +380,15 @@ def orientation_stage(
         spec = atlas_spec(scene, opts.seed, "spot", size["learn_time_s"], compass, spot=spot)
     else:
         spot = spots
-        spec = atlas_spec(scene, opts.seed, "grid", size["learn_time_s"], compass, spots=spots)
+        spec = atlas_spec(
+            scene,
+            opts.seed,
+            "grid",
+            size["learn_time_s"],
+            compass,
+            spots=spots,
+            around_m=GRID_AROUND_M,
+        )
     atlas_path = ensure_atlases(run, [spec], opts.atlas_dir)[atlas_key(spec)]
     trackers = mode_trackers(trackers, mode)
     jobs = view_jobs(

@@ -1,0 +1,63 @@
+"""HomingFeatureExpert: the paper's homing rule on Homing-v0 feature vectors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vc_gym.agents import HomingFeatureExpert
+from vc_gym.envs.homing import STOP_THRESHOLD, HomingFeatures
+
+
+def features(home_fwd: float, home_left: float, spread_deg: float = 5.0, spots: int = 4):
+    f = np.zeros(HomingFeatures.GOODNESS_START + spots + 1, np.float32)
+    f[HomingFeatures.HOME_VECTOR] = np.array([home_fwd, home_left]) / HomingFeatures.METRES_SCALE
+    f[HomingFeatures.HEADING] = (1.0, 0.0)
+    f[HomingFeatures.SPREAD] = spread_deg / HomingFeatures.SPREAD_SCALE_DEG
+    return f
+
+
+def test_walks_straight_to_a_home_ahead():
+    walk, turn, stop = HomingFeatureExpert().predict(features(1.0, 0.0))
+    assert walk == pytest.approx(0.25 / 0.4) and turn == 0.0 and stop < STOP_THRESHOLD
+
+
+@pytest.mark.parametrize("left", [1.0, -1.0])
+def test_turns_on_the_spot_towards_a_home_to_the_side(left):
+    walk, turn, stop = HomingFeatureExpert().predict(features(0.0, left))
+    assert walk <= 0.0 and turn == math.copysign(1.0, left) and stop < STOP_THRESHOLD
+
+
+def test_turns_in_proportion_and_slows_down_near_home():
+    walk, turn, _ = HomingFeatureExpert(max_turn_deg_s=90.0).predict(
+        features(0.2 * math.cos(math.radians(10)), 0.2 * math.sin(math.radians(10)))
+    )
+    assert turn == pytest.approx(25.0 / 90.0, abs=1e-5)  # 2.5 x 10 degrees
+    assert walk == pytest.approx(0.8 * 0.2 / 0.4, abs=1e-5)
+
+
+def test_stops_at_home_and_waits_while_the_heading_is_unsure():
+    expert = HomingFeatureExpert(home_tolerance_m=0.1)
+    assert expert.predict(features(0.05, 0.03))[2] > STOP_THRESHOLD
+    walk, turn, stop = expert.predict(features(2.0, 0.0, spread_deg=60.0))
+    assert walk <= 0.0 and turn == 0.0 and stop < STOP_THRESHOLD
+
+
+def test_a_batch_gives_one_action_per_row():
+    rows = np.stack([features(1.0, 0.0), features(0.0, 0.0)])
+    out = HomingFeatureExpert().predict(rows)
+    assert out.shape == (2, 3) and out.dtype == np.float32 and out[1, 2] > STOP_THRESHOLD
+
+
+@pytest.mark.parametrize("bad", [np.zeros(3), np.full(12, np.nan), np.zeros((2, 2, 12))])
+def test_bad_features_are_rejected(bad):
+    with pytest.raises(ValueError, match="feature vector"):
+        HomingFeatureExpert().predict(bad)
+
+
+@pytest.mark.parametrize("kwargs", [{"max_forward": 0}, {"home_tolerance_m": -1}])
+def test_bad_settings_are_rejected(kwargs):
+    with pytest.raises(ValueError):
+        HomingFeatureExpert(**kwargs)

@@ -1,0 +1,74 @@
+"""The scripted homing behaviour on ``vc_gym/Homing-v0``'s features and actions.
+
+:class:`HomingFeatureExpert` is :class:`~vc_gym.agents.ScriptedHomingPolicy`'s paper
+behaviour (5.2) re-expressed for the env a learned agent sees: it reads the
+:class:`~vc_gym.envs.HomingFeatures` vector and answers with
+:class:`~vc_gym.envs.StopAction`'s ``(walk, turn, stop)``. Its decisions are the
+demonstrations a learned agent is warm-started from (behaviour cloning, ``vc-gym train
+--demo-episodes``). It keeps no memory, like the MLP policy that clones it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vc_gym.envs.homing import HomingFeatures
+from vc_gym.validation import positive_float
+
+__all__ = ["HomingFeatureExpert"]
+
+
+class HomingFeatureExpert:
+    """The paper's homing rule on Homing-v0 feature vectors (a memoryless expert).
+
+    While the heading belief is wider than ``max_spread_deg`` it does not walk; once the
+    estimated home is within ``home_tolerance_m`` it stops; otherwise it turns towards
+    the estimated home (rate ``2.5 × bearing``, as the scripted agent) and walks when
+    the bearing is within 30°, slower when close (``min(0.25, 0.8 d)`` m/s).
+
+    Parameters
+    ----------
+    max_forward : float
+        Walking speed (m/s) of a full walk action (the env's ``max_forward``).
+    max_turn_deg_s : float
+        Turn rate (deg/s) of a full turn action (the env's ``max_turn_deg_s``).
+    home_tolerance_m : float
+        Stop when the estimated home is this close.
+    max_spread_deg : float
+        Do not walk while the heading spread is wider than this.
+    """
+
+    def __init__(
+        self,
+        max_forward: float = 0.4,
+        max_turn_deg_s: float = 60.0,
+        home_tolerance_m: float = 0.1,
+        max_spread_deg: float = 30.0,
+    ):
+        self.max_forward = positive_float("max_forward", max_forward)
+        self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
+        self.home_tolerance_m = positive_float("home_tolerance_m", home_tolerance_m)
+        self.max_spread_deg = positive_float("max_spread_deg", max_spread_deg)
+
+    def predict(self, features: np.ndarray) -> np.ndarray:
+        """``(walk, turn, stop)`` in ``[-1, 1]`` for one feature vector, or one row each
+        for a batch ``(n, d)``."""
+        f = np.asarray(features, dtype=np.float64)
+        if f.ndim == 2:
+            return np.stack([self.predict(row) for row in f]).astype(np.float32)
+        if f.ndim != 1 or f.shape[0] <= HomingFeatures.GOODNESS_START or not np.all(np.isfinite(f)):
+            raise ValueError(f"expected one finite Homing-v0 feature vector, got shape {f.shape}")
+        fwd, left = f[HomingFeatures.HOME_VECTOR] * HomingFeatures.METRES_SCALE
+        spread = f[HomingFeatures.SPREAD] * HomingFeatures.SPREAD_SCALE_DEG
+        dist = math.hypot(fwd, left)
+        if spread > self.max_spread_deg:
+            return np.array([-1.0, 0.0, -1.0], np.float32)  # let the filters settle
+        if dist <= self.home_tolerance_m:
+            return np.array([-1.0, 0.0, 1.0], np.float32)
+        bearing = math.degrees(math.atan2(left, fwd))
+        turn = float(np.clip(2.5 * bearing, -60.0, 60.0)) / self.max_turn_deg_s
+        speed = 0.0 if abs(bearing) > 30 else min(0.25, 0.8 * dist)
+        walk = speed / self.max_forward if speed > 0 else -1.0  # StopAction: max(a, 0)
+        return np.array([np.clip(walk, -1, 1), np.clip(turn, -1, 1), -1.0], np.float32)
