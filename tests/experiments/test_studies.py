@@ -50,8 +50,9 @@ def test_every_experiment_wrote_its_files(paper_quick, name):
 
 
 def test_every_experiment_is_tested_end_to_end():
-    # the paper report runs ORDER; the others have end-to-end tests of their own
-    assert set(EXPERIMENTS) == {*ORDER, "paper", "localization"}
+    # the paper report runs ORDER; the others have end-to-end tests of their own (agents:
+    # tests/experiments/test_training.py, it needs a trained model)
+    assert set(EXPERIMENTS) == {*ORDER, "paper", "localization", "agents"}
 
 
 def test_the_report_sets_our_figures_beside_the_papers(paper_quick):
