@@ -632,7 +632,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="N",
         help="warm start (ppo): clone the scripted expert's decisions in N homing episodes "
         "before PPO starts (DIR/warm_start.json; the clone is evaluated first); 0: from "
-        "scratch (default 0)",
+        "scratch, as with --algo sac (default 60)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

@@ -25,6 +25,7 @@ TINY = TrainConfig(
     eval_freq=32,
     eval_episodes=2,
     save_freq=32,
+    demo_episodes=0,
 )
 
 

@@ -72,7 +72,9 @@ def bench_train(
         and the settings.
     """
     int_at_least("env_steps", env_steps, 1)
-    config = TrainConfig(timesteps=timesteps, n_envs=n_envs, seed=seed, learn_time_s=learn_time_s)
+    config = TrainConfig(  # no warm start: only the training's own speed is measured
+        timesteps=timesteps, n_envs=n_envs, seed=seed, learn_time_s=learn_time_s, demo_episodes=0
+    )
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
         atlas_file = Path(tmp) / "atlas.npz"
         learn_place(config, atlas_file)

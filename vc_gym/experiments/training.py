@@ -33,6 +33,8 @@ from vc_gym.validation import int_at_least, positive_float
 __all__ = ["TrainConfig", "read_train_config", "train"]
 
 CONFIG_SCHEMA = 2
+#: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
+DEFAULT_DEMO_EPISODES = {"ppo": 60, "sac": 0}
 
 #: The PPO policy shipped with the package (trained by ``vc-gym train``, see README);
 #: ``vc-gym evaluate --agent pretrained`` evaluates it.
@@ -98,6 +100,9 @@ class TrainConfig:
         cloned from before PPO starts (:mod:`vc_gym.experiments.imitation`); 0: PPO
         from scratch. They are not counted in ``timesteps``. With evaluations on, the
         clone is evaluated before PPO starts, so the best model can be the clone.
+        Default (``None``): 60 with PPO (about 6,000 decisions; over 60,000 decisions
+        PPO from the clone reached ~80 % success in training, PPO from scratch ~30 %,
+        README), 0 with SAC.
     """
 
     algo: str = "ppo"
@@ -123,11 +128,13 @@ class TrainConfig:
     eval_episodes: int = 10
     eval_seed: int = 1_000_000
     save_freq: int = 0
-    demo_episodes: int = 0
+    demo_episodes: int | None = None
 
     def __post_init__(self) -> None:
         if self.algo not in ALGORITHMS:
             raise ValueError(f"algo must be one of {ALGORITHMS}, got {self.algo!r}")
+        if self.demo_episodes is None:
+            object.__setattr__(self, "demo_episodes", DEFAULT_DEMO_EPISODES[self.algo])
         if not isinstance(self.tracker, str):
             raise ValueError(f"tracker must be a tracker name, got {self.tracker!r}")
         if self.vec_env not in ("subproc", "dummy"):
@@ -148,7 +155,7 @@ class TrainConfig:
             v = getattr(self, name)
             positive_float(name, v)
         if self.demo_episodes and self.algo != "ppo":
-            raise ValueError("demo_episodes (the warm start) needs algo 'ppo'")
+            raise ValueError("demo_episodes (the warm start) needs algo 'ppo'; use 0 with sac")
         if not (0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
         if not self.net_arch or any(int(n) < 1 for n in self.net_arch):
