@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["finite_float", "int_at_least", "nonnegative_float", "positive_float"]
+__all__ = ["finite_float", "finite_real", "int_at_least", "nonnegative_float", "positive_float"]
 
 
 def finite_float(name: str, value: object) -> float:
@@ -14,6 +14,15 @@ def finite_float(name: str, value: object) -> float:
         v = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def finite_real(name: str, value: object) -> float:
+    """``float(value)`` for a finite real number; strings and bools are refused (a
+    setting given ``"56.9"`` or ``True`` is a mistake, not a number)."""
+    v = _real(name, value)
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {value!r}")
     return v

@@ -46,8 +46,18 @@ def test_principal_point_crop():
         {"pitch_deg": 90.0},
         {"principal_point": (1.0,)},
         {"principal_point": (1.0, float("nan"))},
+        {"hfov_deg": True},  # used to become a 1-degree lens
+        {"hfov_deg": "56.9"},  # used to be accepted and fail later
+        {"yaw_deg": 1e17},  # used to learn 4 of 14 sectors
+        {"yaw_deg": -1e300},
+        {"pitch_deg": False},
     ],
 )
 def test_bad_camera(kwargs):
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="hfov_deg|yaw_deg|pitch_deg|principal_point|cx|cy"):
         Camera(**kwargs)
+
+
+def test_a_large_but_exact_yaw_is_the_same_direction():
+    far = Camera(yaw_deg=360.0 * 10**6 + 30.0)
+    assert far.column_directions_deg(np.array([103.5]), 208, 160)[0] % 360 == pytest.approx(30.0)

@@ -248,6 +248,8 @@ def test_config_validation():
         {"n_bins": 1},
         {"coverage": 0.0},
         {"coverage": float("nan")},
+        {"coverage": 1e-9},  # used to learn nothing
+        {"coverage": 0.0009},
         {"heading_step_deg": 0.7},
         {"smoothing": -1.0},
         {"temperature": 0.0},

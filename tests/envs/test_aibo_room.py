@@ -204,6 +204,8 @@ def test_repeated_make_close_does_not_leak_clients():
         {"locomotion": "teleport"},
         {"illumination": 0.0},
         {"illumination": float("nan")},
+        {"illumination": 100.0},
+        {"illumination": True},
         {"control_dt": 0.0},
         {"render_mode": "ascii"},
         {"randomize": "yes"},
@@ -212,6 +214,15 @@ def test_repeated_make_close_does_not_leak_clients():
 def test_bad_arguments(kwargs):
     with pytest.raises(ValueError):
         gym.make("vc_gym/AiboRoom-v0", **kwargs)
+
+
+@pytest.mark.parametrize("pose", [(100.0, 100.0, 0.0), (0.0, -3.48, 0.0), (np.nan, 0.0, 0.0)])
+def test_a_pose_outside_the_walls_is_refused(pose):
+    env = make("vc_gym/AiboRoom-v0")
+    with pytest.raises(ValueError, match="pose"):
+        env.reset(seed=0, options={"pose": pose})
+    env.reset(seed=0, options={"pose": (3.3, -3.3, 10.0)})  # near a corner, inside: fine
+    env.close()
 
 
 def test_bad_actions():

@@ -197,6 +197,24 @@ def test_bad_arguments(kwargs):
         gym.make("vc_gym/LearnThenHome-v0", **kwargs)
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [({"kidnap_margin_m": 100.0}, "kidnap_margin_m"), ({"spot_distance_m": 50.0}, "walls")],
+)
+def test_settings_the_scene_cannot_hold_are_refused_before_learning(kwargs, match):
+    calls = []
+
+    def learner(room, config):  # must never run
+        calls.append(1)
+        raise AssertionError("learned")
+
+    env = gym.make("vc_gym/LearnThenHome-v0", learner=learner, **kwargs)
+    with pytest.raises(ValueError, match=match):
+        env.reset(seed=0)
+    assert calls == []
+    env.close()
+
+
 def test_bad_actions_and_closed_env(learner):
     e = gym.make("vc_gym/LearnThenHome-v0", learner=learner)
     with pytest.raises(RuntimeError, match="reset"):

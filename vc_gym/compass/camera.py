@@ -15,12 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vc_gym.validation import finite_float as _finite
+from vc_gym.validation import finite_real as _finite
 
-__all__ = ["Camera", "AIBO_HFOV_DEG", "AIBO_RESOLUTION"]
+__all__ = ["Camera", "AIBO_HFOV_DEG", "AIBO_RESOLUTION", "MAX_ABS_YAW_DEG"]
 
 #: Horizontal field of view of the Sony Aibo ERS-7 camera (degrees).
 AIBO_HFOV_DEG = 56.9
+#: Largest ``|yaw_deg|`` a camera takes: beyond it float64 holds the angle to worse than
+#: a millionth of a degree, and further out the sectors would come out wrong.
+MAX_ABS_YAW_DEG = 1e9
 #: (width, height) of the Aibo ERS-7 camera image.
 AIBO_RESOLUTION = (208, 160)
 
@@ -55,7 +58,9 @@ class Camera:
         hfov = _finite("hfov_deg", self.hfov_deg)
         if not 0.0 < hfov < 180.0:
             raise ValueError(f"hfov_deg must be in (0, 180), got {hfov}")
-        _finite("yaw_deg", self.yaw_deg)
+        if abs(_finite("yaw_deg", self.yaw_deg)) > MAX_ABS_YAW_DEG:
+            # far out, float64 cannot hold a fraction of a degree: sectors would be wrong
+            raise ValueError(f"|yaw_deg| must be <= {MAX_ABS_YAW_DEG:g}, got {self.yaw_deg!r}")
         pitch = _finite("pitch_deg", self.pitch_deg)
         if not -90.0 < pitch < 90.0:
             raise ValueError(f"pitch_deg must be in (-90, 90), got {pitch}")

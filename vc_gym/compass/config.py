@@ -5,10 +5,12 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, fields
 
-__all__ = ["CompassConfig", "EXPOSURE_MODES"]
+__all__ = ["CompassConfig", "EXPOSURE_MODES", "MIN_COVERAGE"]
 
 #: Accepted values of :attr:`CompassConfig.exposure`.
 EXPOSURE_MODES = ("none", "mean")
+#: Smallest scanning coverage (0.1 %); the paper reports that < 1 % still works.
+MIN_COVERAGE = 0.001
 
 
 def _is_divisor_of_360(step: float) -> bool:
@@ -31,7 +33,7 @@ class CompassConfig:
         ``2^-(k+1) < z <= 2^-k``, the last bin also ``z <= 2^-(n-1)`` and zero.
     coverage : float
         Fraction of pixels on the scanning grid (paper: 0.25 = every 2nd row and
-        column). ``0 < coverage <= 1``.
+        column). ``0.001 <= coverage <= 1`` (0.1 %: every 32nd row and column).
     heading_step_deg : float
         Resolution of the heading grid on which likelihoods are returned (default 1°).
         Must divide 360.
@@ -89,8 +91,9 @@ class CompassConfig:
             raise ValueError(f"sector_deg must be in (0, 90] and divide 360, got {self.sector_deg}")
         if not 2 <= self.n_bins <= 32:
             raise ValueError(f"n_bins must be in 2..32, got {self.n_bins}")
-        if not 0 < self.coverage <= 1:
-            raise ValueError(f"coverage must be in (0, 1], got {self.coverage}")
+        if not MIN_COVERAGE <= self.coverage <= 1:
+            # below it the grid's steps exceed a small image: it would learn nothing
+            raise ValueError(f"coverage must be in [{MIN_COVERAGE}, 1], got {self.coverage}")
         if not 0 < self.heading_step_deg <= 90 or not _is_divisor_of_360(self.heading_step_deg):
             raise ValueError(
                 f"heading_step_deg must be in (0, 90] and divide 360, got {self.heading_step_deg}"

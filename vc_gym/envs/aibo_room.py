@@ -19,7 +19,12 @@ from vc_gym.envs.scenes import Scene, build_scene, check_scene_name
 from vc_gym.envs.top_view import TopView
 from vc_gym.validation import positive_float
 
-__all__ = ["AiboRoomEnv"]
+__all__ = ["AiboRoomEnv", "MAX_ILLUMINATION", "ROBOT_CLEARANCE_M"]
+
+#: Brightest ``illumination`` (linear light; 1 is normal, above it frames saturate).
+MAX_ILLUMINATION = 4.0
+#: A placed robot's centre keeps this far inside the room's walls.
+ROBOT_CLEARANCE_M = 0.1
 
 #: Bounds of the odometry observation (m, m, degrees): far beyond one step's motion.
 _ODO_LIMIT = np.array([5.0, 5.0, 720.0], np.float32)
@@ -122,7 +127,11 @@ class AiboRoomEnv(gym.Env):
             raise ValueError(f"locomotion must be one of {LOCOMOTION_MODES}, got {locomotion!r}")
         if not isinstance(randomize, bool):
             raise ValueError(f"randomize must be a bool, got {randomize!r}")
-        positive_float("illumination", illumination)
+        if positive_float("illumination", illumination) > MAX_ILLUMINATION:
+            raise ValueError(
+                f"illumination must be in (0, {MAX_ILLUMINATION:g}] (1: normal), "
+                f"got {illumination!r}"
+            )
         if not (math.isfinite(control_dt) and 0 < control_dt <= 1.0):
             raise ValueError(f"control_dt must be in (0, 1] seconds, got {control_dt!r}")
         if light_direction is not None:
@@ -240,6 +249,13 @@ class AiboRoomEnv(gym.Env):
             x, y, yaw = (float(v) for v in options["pose"])
             if not all(math.isfinite(v) for v in (x, y, yaw)):
                 raise ValueError(f"pose must be 3 finite numbers, got {options['pose']!r}")
+            rx0, rx1, ry0, ry1 = self.scene.room_bounds
+            c = ROBOT_CLEARANCE_M
+            if not (rx0 + c <= x <= rx1 - c and ry0 + c <= y <= ry1 - c):
+                raise ValueError(
+                    f"pose {options['pose']!r} is not inside the walls of {self.scene_name!r} "
+                    f"(x {rx0 + c:g}..{rx1 - c:g}, y {ry0 + c:g}..{ry1 - c:g} m)"
+                )
         else:
             fx0, fx1, fy0, fy1 = self.scene.field_bounds
             x = float(self.np_random.uniform(fx0, fx1))

@@ -13,7 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.aibo_room import ROBOT_CLEARANCE_M, AiboRoomEnv
 from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.envs.learning import (
     HOME,
@@ -283,6 +283,27 @@ class LearnThenHomeEnv(gym.Env):
         self._distance = self._home_distance(info)
         return obs, info
 
+    def _check_fits_scene(self) -> None:
+        """Refuse settings the scene cannot hold, before any learning is done."""
+        fx0, fx1, fy0, fy1 = self.room.scene.field_bounds
+        m, side = self.kidnap_margin_m, min(fx1 - fx0, fy1 - fy0)
+        if 2 * m >= side:
+            raise ValueError(
+                f"kidnap_margin_m={m} leaves no room on the {fx1 - fx0:g} x {fy1 - fy0:g} m "
+                f"field of {self.room.scene_name!r} (it must be < {side / 2:g})"
+            )
+        if self.learning == "scripted":
+            rx0, rx1, ry0, ry1 = self.room.scene.room_bounds
+            d, c = self.learn_config.spot_distance_m, ROBOT_CLEARANCE_M
+            hx, hy = HOME
+            if not (
+                rx0 + c < hx - d and hx + d < rx1 - c and ry0 + c < hy - d and hy + d < ry1 - c
+            ):
+                raise ValueError(
+                    f"spot_distance_m={d} puts the learning spots outside the walls of "
+                    f"{self.room.scene_name!r} (room x {rx0:g}..{rx1:g}, y {ry0:g}..{ry1:g} m)"
+                )
+
     # ------------------------------------------------------------------ gym API
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -306,6 +327,7 @@ class LearnThenHomeEnv(gym.Env):
             return self._obs(obs), self._info(info)
         learn_seed = room_seed if self.learning_seed is None else self.learning_seed
         obs, info = self.room.reset(seed=learn_seed, options={"pose": (*HOME, 0.0)})
+        self._check_fits_scene()
         if self.learning == "agent":
             self.atlas = self.learning_result = None
             self._frames = []
