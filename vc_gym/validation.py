@@ -5,7 +5,22 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["finite_float", "finite_real", "int_at_least", "nonnegative_float", "positive_float"]
+__all__ = [
+    "MAX_ABS_DEG",
+    "MAX_ABS_METRES",
+    "finite_float",
+    "finite_real",
+    "int_at_least",
+    "nonnegative_float",
+    "positive_float",
+]
+
+#: Largest magnitude of a length (metres) a filter or env takes in one input: a step
+#: of a million metres is a units mistake, and far beyond it sums overflow.
+MAX_ABS_METRES = 1e6
+#: Largest magnitude of an angle (degrees) taken in one input: float64 still holds it
+#: to a millionth of a degree, and squares of it do not overflow.
+MAX_ABS_DEG = 1e9
 
 
 def finite_float(name: str, value: object) -> float:

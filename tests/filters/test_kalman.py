@@ -230,6 +230,10 @@ def test_heading_always_in_range_and_spread_shrinks_on_update(h0, steps):
         lambda f: f.update(10.0, 0.0),
         lambda f: f.update(10.0, -1.0),
         lambda f: f.update(10.0, 1e-200),
+        lambda f: f.update(20.0, 1e-160),  # used to leave the filter failing on every call
+        lambda f: f.update(1e300, 1.0),
+        lambda f: f.predict(10.0, noise_deg=1e155),  # used to leave the filter failing too
+        lambda f: f.predict(1e300),
         lambda f: f.predict(math.nan),
         lambda f: f.predict(1.0, noise_deg=-0.1),
         lambda f: f.predict(1.0, noise_deg=math.inf),
@@ -252,6 +256,9 @@ def test_bad_input_raises_value_error_and_keeps_state(call):
     with pytest.raises(ValueError):
         call(f)
     assert f.estimate() == before
+    f.predict(5.0)  # and the filter still works
+    f.update(47.0, 2.0)
+    assert abs(wrap180(f.estimate().heading_deg - 47.0)) < 2.0
 
 
 @pytest.mark.parametrize(

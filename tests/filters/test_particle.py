@@ -461,3 +461,17 @@ def test_resampling_injects_poses_from_a_given_sampler():
     assert asked == [10]  # a flat sensor: no resampling, nothing injected
     with pytest.raises(ValueError):
         pf.resample(inject=lambda k: np.zeros((k, 2)))
+
+
+@pytest.mark.parametrize(
+    ("odometry", "noise"),
+    [((1e308, 0.0, 0.0), (0.0, 0.0, 0.0)), ((0.0, 0.0, 0.0), (0.0, 0.0, 1e300))],
+)
+def test_motion_beyond_physical_limits_is_refused(odometry, noise):
+    # odometry of 1e308 m used to give a NaN estimate silently
+    pf = ParticleFilter(100, rng=np.random.default_rng(0))
+    pf.reset(mean=(0.0, 0.0, 0.0), std=(0.1, 0.1, 5.0))
+    with pytest.raises(ValueError, match="within"):
+        pf.predict(odometry, noise)
+    e = pf.estimate()
+    assert np.isfinite(e.x) and np.isfinite(e.y)

@@ -45,3 +45,14 @@ def test_bad_construction():
         TranslationalFilter(SPOTS, half_life_s=-1)
     with pytest.raises(ValueError):
         TranslationalFilter(SPOTS).predict(np.nan, 0.0)
+
+
+@pytest.mark.parametrize(
+    "call", [lambda f: f.predict(1e308, 0.0), lambda f: f.update_position((1e7, 0))]
+)
+def test_huge_motion_or_position_is_refused_and_the_estimate_stays_finite(call):
+    f = TranslationalFilter(SPOTS)
+    with pytest.raises(ValueError, match="1e\\+06 m"):
+        call(f)
+    f.predict(2.0, 0.0)
+    assert f.position == pytest.approx((2.0, 0.0))

@@ -36,10 +36,13 @@ from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 from vc_gym.angles import circular_mean, circular_std, wrap180, wrap360
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
+from vc_gym.validation import MAX_ABS_DEG, positive_float
 from vc_gym.validation import finite_float as _finite
-from vc_gym.validation import positive_float
 
-__all__ = ["KalmanHeadingFilter"]
+__all__ = ["MIN_SPREAD_DEG", "KalmanHeadingFilter"]
+
+#: Smallest measurement spread :meth:`KalmanHeadingFilter.update` takes (degrees).
+MIN_SPREAD_DEG = 1e-6
 
 #: Sigma-point parameters (Van der Merwe). A small α keeps the sigma points within
 #: ``0.17 σ`` of the mean, so they never wrap around the circle; β = 2 is optimal for
@@ -274,6 +277,12 @@ class KalmanHeadingFilter:
         q = _finite("noise_deg", noise_deg)
         if q < 0.0:
             raise ValueError(f"noise_deg must be >= 0, got {noise_deg!r}")
+        if abs(d) > MAX_ABS_DEG or q > MAX_ABS_DEG:
+            # larger values overflow the variance and break every later call
+            raise ValueError(
+                f"dtheta_deg and noise_deg must be within ±{MAX_ABS_DEG:g}, got "
+                f"{dtheta_deg!r}, {noise_deg!r}"
+            )
         step = positive_float("dt", dt)
         ukf = self._ukf
         if self._with_rate:
@@ -306,18 +315,21 @@ class KalmanHeadingFilter:
         Raises
         ------
         ValueError
-            On a non-finite heading, or a spread that is NaN, ``<= 0`` or so small
-            that its square underflows to 0.
+            On a non-finite heading, or a spread that is NaN or below
+            :data:`MIN_SPREAD_DEG` (a millionth of a degree).
         """
         z = _finite("heading_deg", heading_deg)
+        if abs(z) > MAX_ABS_DEG:
+            raise ValueError(f"heading_deg must be within ±{MAX_ABS_DEG:g}, got {heading_deg!r}")
         s = float(spread_deg)
         if math.isnan(s) or s <= 0.0:
             raise ValueError(f"spread_deg must be > 0, got {spread_deg!r}")
         var = s * s
         if not math.isfinite(var):
             return  # uninformative measurement: documented no-op
-        if var == 0.0:
-            raise ValueError(f"spread_deg is too small (its square underflows), got {spread_deg!r}")
+        if s < MIN_SPREAD_DEG:
+            # a near-zero variance collapses the belief and breaks every later call
+            raise ValueError(f"spread_deg must be >= {MIN_SPREAD_DEG:g}, got {spread_deg!r}")
         ukf = self._ukf
         # sigma points of the current belief (filterpy reuses those of the last predict),
         # so an update right after reset or a second update without predict is consistent

@@ -30,6 +30,7 @@ import numpy as np
 
 from vc_gym.angles import circular_mean, circular_std, wrap360
 from vc_gym.filters.protocol import PoseSensor, check_log_likelihood
+from vc_gym.validation import MAX_ABS_DEG, MAX_ABS_METRES
 
 __all__ = ["ParticleFilter", "PoseEstimate"]
 
@@ -60,6 +61,17 @@ class PoseEstimate:
     std_xy: tuple[float, float]
     spread_deg: float
     ess: float
+
+
+def _motion(name: str, value: object, *, nonneg: bool = False) -> np.ndarray:
+    """:func:`_triple` within the physical limits of one step (metres, metres, degrees):
+    beyond them positions overflow to inf and the estimate becomes NaN."""
+    a = _triple(name, value, nonneg=nonneg)
+    if max(abs(a[0]), abs(a[1])) > MAX_ABS_METRES or abs(a[2]) > MAX_ABS_DEG:
+        raise ValueError(
+            f"{name} must be within ±{MAX_ABS_METRES:g} m and ±{MAX_ABS_DEG:g}°, got {value!r}"
+        )
+    return a
 
 
 def _triple(name: str, value: object, *, nonneg: bool = False) -> np.ndarray:
@@ -327,10 +339,11 @@ class ParticleFilter:
         Raises
         ------
         ValueError
-            Non-finite odometry, or negative / non-finite noise.
+            Non-finite odometry, or negative / non-finite noise, or either beyond a
+            million metres or a billion degrees.
         """
-        u = _triple("odometry", odometry)
-        s = _triple("noise", noise, nonneg=True)
+        u = _motion("odometry", odometry)
+        s = _motion("noise", noise, nonneg=True)
         d = u + self._rng.standard_normal((self._n, 3)) * s
         th = np.radians(self._particles[:, 2])
         c, sn = np.cos(th), np.sin(th)

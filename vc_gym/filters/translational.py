@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from vc_gym.filters.grid import mixing_lambda
+from vc_gym.validation import MAX_ABS_METRES
 
 __all__ = ["TranslationalFilter", "weighted_spot_position"]
 
@@ -22,6 +23,8 @@ def _vector(name: str, value: object, n: int) -> np.ndarray:
     a = np.asarray(value, dtype=np.float64)
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must be {n} finite numbers, got {value!r}")
+    if np.any(np.abs(a) > MAX_ABS_METRES):  # sums of such values overflow to inf
+        raise ValueError(f"{name} must be within ±{MAX_ABS_METRES:g} m, got {value!r}")
     return a
 
 
