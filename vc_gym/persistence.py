@@ -20,6 +20,8 @@ import numpy as np
 from vc_gym.errors import MapFileError
 
 __all__ = [
+    "MAX_ENTRY_BYTES",
+    "MAX_TOTAL_BYTES",
     "json_array",
     "load_npz_checked",
     "read_json_array",
@@ -93,6 +95,8 @@ def read_json_array(arrays: Mapping[str, np.ndarray], key: str, path: str | os.P
         return json.loads(str(a))
     except json.JSONDecodeError as e:
         raise MapFileError(f"{path}: entry {key!r} is not valid JSON ({e})") from None
+    except RecursionError:
+        raise MapFileError(f"{path}: entry {key!r} is nested too deeply") from None
 
 
 def save_npz_atomic(
@@ -134,14 +138,36 @@ def save_npz_atomic(
     return write_atomic(path, write)
 
 
-def load_npz_checked(path: str | os.PathLike, schema: str, version: int) -> dict[str, np.ndarray]:
-    """Load every array of an ``.npz`` written by :func:`save_npz_atomic`.
+#: Largest array entry a checked ``.npz`` may hold, uncompressed (the largest map entry,
+#: a 32-class compass's counts, is about 10 MB).
+MAX_ENTRY_BYTES = 64 * 2**20
+#: Largest sum of its entries, uncompressed.
+MAX_TOTAL_BYTES = 256 * 2**20
+#: Array kinds a vc_gym file holds: bool, integers, reals and text.
+_KINDS = "biufU"
+
+
+def load_npz_checked(
+    path: str | os.PathLike,
+    schema: str,
+    version: int,
+    max_entry_bytes: int = MAX_ENTRY_BYTES,
+    max_total_bytes: int = MAX_TOTAL_BYTES,
+) -> dict[str, np.ndarray]:
+    """Load every array of an ``.npz`` written by :func:`save_npz_atomic`, safely.
+
+    Nothing is decompressed before it is checked: every zip entry must be a ``.npy``
+    array whose sizes (the zip's and the one its header declares) agree and stay within
+    ``max_entry_bytes`` (all entries together within ``max_total_bytes``), of a plain
+    kind (bool, integer, real, text: never objects, so nothing is unpickled) and
+    named once. A hostile file therefore cannot run code or exhaust memory.
 
     Raises
     ------
     MapFileError
-        If the file is missing, empty, truncated or corrupt, has no or another
-        schema, or another schema version.
+        If the file is missing, empty, truncated, corrupt or not a zip, holds an entry
+        that is not a plain array or is too large, has no or another schema, or a
+        schema version that is not this integer.
     """
     path = Path(path)
     if not path.is_file():
@@ -149,21 +175,60 @@ def load_npz_checked(path: str | os.PathLike, schema: str, version: int) -> dict
     if path.stat().st_size == 0:
         raise MapFileError(f"{path}: file is empty")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as e:
+        arrays = _read_entries(path, max_entry_bytes, max_total_bytes)
+    except MapFileError:
+        raise
+    except Exception as e:  # noqa: BLE001 - a hostile file finds every kind: zlib.error,
+        # BadZipFile, NotImplementedError (zip version), TokenError (npy header), ...
         raise MapFileError(f"{path}: not a readable .npz file ({type(e).__name__}: {e})") from None
     if "schema" not in arrays or "schema_version" not in arrays:
         raise MapFileError(f"{path}: not a vc_gym file (no schema / schema_version entry)")
-    got_schema = str(arrays.pop("schema"))
-    if got_schema != schema:
-        raise MapFileError(f"{path}: holds a {got_schema!r}, expected a {schema!r}")
-    try:
-        got_version = int(arrays.pop("schema_version"))
-    except (TypeError, ValueError):
-        raise MapFileError(f"{path}: schema_version is not an integer") from None
-    if got_version != version:
+    got = arrays.pop("schema")
+    if got.dtype.kind != "U" or got.ndim != 0:
+        raise MapFileError(f"{path}: schema is not a text entry")
+    if str(got) != schema:
+        raise MapFileError(f"{path}: holds a {str(got)!r}, expected a {schema!r}")
+    got_version = arrays.pop("schema_version")
+    if got_version.dtype.kind not in "iu" or got_version.ndim != 0:
+        # "1" or 1.9 is not version 1
+        raise MapFileError(f"{path}: schema_version is not an integer")
+    if int(got_version) != version:
         raise MapFileError(
-            f"{path}: schema version {got_version}, this vc_gym reads version {version}"
+            f"{path}: schema version {int(got_version)}, this vc_gym reads version {version}"
         )
+    return arrays
+
+
+def _read_entries(path: Path, max_entry: int, max_total: int) -> dict[str, np.ndarray]:
+    """The arrays of the zip at ``path``, each checked before it is decompressed."""
+    arrays: dict[str, np.ndarray] = {}
+    with zipfile.ZipFile(path) as zf:
+        infos = zf.infolist()
+        total = sum(i.file_size for i in infos)
+        if total > max_total:
+            raise MapFileError(f"{path}: its entries hold {total} bytes, more than {max_total}")
+        for info in infos:
+            name = info.filename
+            if not name.endswith(".npy") or name[:-4] in arrays:
+                raise MapFileError(f"{path}: unexpected or repeated entry {name!r}")
+            if info.file_size > max_entry:
+                raise MapFileError(f"{path}: entry {name!r} is larger than {max_entry} bytes")
+            with zf.open(info) as fh:
+                major, minor = np.lib.format.read_magic(fh)
+                read_header = (
+                    np.lib.format.read_array_header_1_0
+                    if (major, minor) == (1, 0)
+                    else np.lib.format.read_array_header_2_0
+                )
+                shape, fortran, dtype = read_header(fh)
+                if dtype.kind not in _KINDS or dtype.hasobject:
+                    raise MapFileError(f"{path}: entry {name!r} has dtype {dtype}, not plain data")
+                nbytes = int(np.prod(shape, dtype=object)) * dtype.itemsize
+                if nbytes != info.file_size - fh.tell():
+                    raise MapFileError(
+                        f"{path}: entry {name!r} declares shape {shape} ({nbytes} bytes) but "
+                        f"holds {info.file_size - fh.tell()} bytes"
+                    )
+            with zf.open(info) as fh:
+                arrays[name[:-4]] = np.lib.format.read_array(fh, allow_pickle=False)
     return arrays

@@ -601,6 +601,8 @@ class VisualCompass:
                 )
         counts = arrays["counts"].astype(np.float64)
         n_obs = arrays["sector_observations"].astype(np.float64)
+        if np.any(counts < 0) or np.any(n_obs < 0):
+            raise MapFileError(f"{path}: negative counts")
         # every class pair of a sector gets exactly one count per frame that saw it
         per_pair = counts.sum(axis=2)
         if not np.array_equal(per_pair, np.broadcast_to(n_obs[:, None], per_pair.shape)):
@@ -609,13 +611,25 @@ class VisualCompass:
         if frames < 0 or (frames == 0) != (n_obs.sum() == 0):
             raise MapFileError(f"{path}: frames_learned={frames} contradicts the counts")
         ref = arrays.get("exposure_reference")
-        if ref is None or ref.shape != () or not np.isfinite(ref) or ref < 0:
+        if (
+            ref is None
+            or ref.shape != ()
+            or ref.dtype.kind not in "iuf"
+            or not np.isfinite(ref)
+            or ref < 0
+        ):
             raise MapFileError(f"{path}: entry 'exposure_reference' missing or invalid")
         if stored.exposure == "mean" and ref <= 0:
             raise MapFileError(f"{path}: exposure='mean' but no reference level stored")
         vc._exposure_ref = float(ref)
         sizes = arrays.get("learned_sizes")
-        if sizes is None or sizes.ndim != 2 or sizes.shape[1] != 2 or sizes.dtype.kind not in "iu":
+        if (
+            sizes is None
+            or sizes.ndim != 2
+            or sizes.shape[1] != 2
+            or sizes.dtype.kind not in "iu"
+            or np.any(sizes < 1)
+        ):
             raise MapFileError(f"{path}: entry 'learned_sizes' missing or not an (N, 2) int array")
         vc._counts[:] = counts
         vc._n_obs[:] = n_obs
