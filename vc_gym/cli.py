@@ -141,6 +141,10 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
+    if args.out:  # a bad --out fails now, not after the benchmark
+        from vc_gym.experiments.output import check_out_file
+
+        check_out_file(args.out)
     if args.what == "compass":
         from vc_gym.experiments.bench_compass import bench_compass
 

@@ -171,11 +171,33 @@ def test_bad_arguments_fail_before_any_work(tmp_path, capsys, argv, message):
     assert not (out / "jobs").exists()
 
 
-def test_an_output_that_is_a_file_is_refused_at_once(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["experiment", "homing", "--quick"],
+        ["demo", "--learn-time", "0.2"],  # used to be a FileExistsError traceback
+        ["render"],  # the same
+        ["evaluate", "--episodes", "1"],
+        ["train", "--timesteps", "64"],
+    ],
+)
+def test_an_output_that_is_a_file_is_refused_at_once(tmp_path, capsys, argv):
     (tmp_path / "taken").write_text("mine")
-    assert main(["experiment", "homing", "--out", str(tmp_path / "taken"), "--quick"]) == 2
+    assert main([*argv, "--out", str(tmp_path / "taken")]) == 2
     assert "not a folder" in capsys.readouterr().err
     assert (tmp_path / "taken").read_text() == "mine"
+
+
+def test_bench_refuses_a_folder_as_its_output_file_before_measuring(tmp_path, capsys):
+    # it used to measure, then fail with IsADirectoryError and leave a stray temp file
+    assert main(["bench", "compass", "--out", str(tmp_path)]) == 2
+    assert "is a folder" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_demo_rejects_bad_values_before_making_its_folder(tmp_path, capsys):
+    assert main(["demo", "--learn-time", "-1", "--out", str(tmp_path / "new")]) == 2
+    assert "learn_time_s" in capsys.readouterr().err and not (tmp_path / "new").exists()
 
 
 def test_bench_backends_measures_every_backend_on_the_same_jobs():

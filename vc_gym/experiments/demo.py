@@ -18,7 +18,7 @@ import numpy as np
 from vc_gym.envs.learning import LearningResult, ScriptedLearning
 from vc_gym.envs.top_view import TopView
 from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
-from vc_gym.experiments.output import new_figure, save_figure, write_json
+from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import TrackerSpec, make_tracker
 from vc_gym.validation import positive_float
 
@@ -72,8 +72,7 @@ def run_demo(
     positive_float("success_radius_m", success_radius_m)
     positive_float("max_homing_s", max_homing_s)
     make_tracker(tracker)  # fail before any work
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_out_dir(out_dir)
     t0 = time.perf_counter()
     run = make_homing_run(
         "scripted",

@@ -16,7 +16,44 @@ from matplotlib.figure import Figure
 
 from vc_gym.persistence import write_atomic
 
-__all__ = ["new_figure", "save_figure", "write_json"]
+__all__ = ["check_out_dir", "check_out_file", "new_figure", "save_figure", "write_json"]
+
+
+def check_out_dir(path: str | os.PathLike) -> Path:
+    """Make sure ``path`` is (or can become) a writable folder, before any work starts.
+
+    Raises
+    ------
+    ValueError
+        ``--out PATH: ...`` for an existing file or a place that cannot be written.
+    """
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out}: exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".write-test-{os.getpid()}"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
+    return out
+
+
+def check_out_file(path: str | os.PathLike) -> Path:
+    """Make sure a result file can be written at ``path``, before any work starts (its
+    folder is created; an existing file there will be replaced).
+
+    Raises
+    ------
+    ValueError
+        ``--out PATH: ...`` for a folder or a place that cannot be written.
+    """
+    out = Path(path)
+    if out.is_dir():
+        raise ValueError(f"--out {out}: is a folder; give a file name (e.g. {out / 'bench.json'})")
+    check_out_dir(out.parent if str(out.parent) else ".")
+    return out
 
 
 def write_json(path: str | os.PathLike, obj: object) -> None:

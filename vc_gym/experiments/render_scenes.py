@@ -11,6 +11,7 @@ import numpy as np
 
 from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.scenes import check_scene_name, scene_names
+from vc_gym.experiments.output import check_out_dir
 from vc_gym.persistence import write_atomic
 
 __all__ = ["render_scene_pictures"]
@@ -69,8 +70,7 @@ def render_scene_pictures(
     scenes = scene_names() if scenes is None else tuple(scenes)
     for scene in scenes:
         check_scene_name(scene)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_out_dir(out_dir)
     written = []
     for scene in scenes:
         env = AiboRoomEnv(render_mode="rgb_array", scene=scene, randomize=randomize)

@@ -39,7 +39,7 @@ from typing import Any
 
 from tqdm import tqdm
 
-from vc_gym.experiments.output import write_json
+from vc_gym.experiments.output import check_out_dir, write_json
 
 __all__ = [
     "BACKENDS",
@@ -438,20 +438,6 @@ def make_backend(
 
 
 # --------------------------------------------------------------------------- the run
-def check_out_dir(path: str | os.PathLike) -> Path:
-    """Make sure ``path`` is (or can become) a writable folder, before any work starts."""
-    out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out}: exists and is not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / f".write-test-{os.getpid()}"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise ValueError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
-    return out
-
 
 def package_versions() -> dict[str, str]:
     """Versions of Python and the packages whose behaviour the figures depend on."""

@@ -25,8 +25,7 @@ from vc_gym.agents.learned import ALGORITHMS, algorithm_class
 from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
-from vc_gym.experiments.output import new_figure, save_figure, write_json
-from vc_gym.experiments.runner import check_out_dir
+from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.persistence import write_atomic
 from vc_gym.validation import int_at_least, positive_float
 

@@ -20,8 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.experiments.output import new_figure, save_figure, write_json
-from vc_gym.experiments.runner import check_out_dir
+from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.homing import PAPER_MEAN_CM, PAPER_STD_CM, run_homing
 
