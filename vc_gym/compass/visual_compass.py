@@ -441,10 +441,20 @@ class VisualCompass:
     def _sector_features(
         self, image: np.ndarray, camera: Camera
     ) -> tuple[_Geometry, np.ndarray, np.ndarray]:
-        """Counts per (phase, relative sector, pair) and which of them saw anything."""
+        """Counts per (phase, relative sector, pair) and which of them saw anything.
+
+        A frame without a single change of colour class above the horizon (a black,
+        covered or overexposed frame, a blank wall) says nothing about the heading: it
+        gives no counts at all, so it is treated like a frame that sees nothing above
+        the horizon (a flat log-likelihood), not as a confident match of the maps'
+        "no change" statistics.
+        """
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
         colcounts = self._column_counts(image, geom)
+        c = self.config.n_colors
+        if not colcounts.reshape(-1, c, c).sum(axis=0)[~np.eye(c, dtype=bool)].any():
+            colcounts = np.zeros_like(colcounts)
         # integer counts in float32: the cumulative sums and their differences are exact
         cum = np.zeros((colcounts.shape[0] + 1, colcounts.shape[1]), dtype=colcounts.dtype)
         np.cumsum(colcounts, axis=0, out=cum[1:])
