@@ -63,6 +63,25 @@ WALL_PPM = 128.0
 #: Texture resolution the built-in scenes use for their floors (pixels per metre).
 FLOOR_PPM = 100.0
 _MAX_SHAPES = 16  # createVisualShapeArray segfaults above 16 shapes (pybullet 3.2.7)
+
+#: pybullet (3.2.7) never releases the lists given to ``createVisualShape`` as a mesh's
+#: vertices, indices, uvs and normals (nor their rows): every scene build leaked ~20 KB
+#: of them, for every env made and closed. Passing the same list objects for the same
+#: geometry turns that leak into reference counts on lists kept here once.
+_SHARED_LISTS: dict[tuple, list] = {}
+_MAX_SHARED_LISTS = 100_000  # randomised scenes make new geometry; bound what is kept
+
+
+def _shared_list(rows: list) -> list:
+    """The one list object kept for this content (see :data:`_SHARED_LISTS`)."""
+    nested = bool(rows) and isinstance(rows[0], list)
+    key = (nested, tuple(tuple(r) for r in rows) if nested else tuple(rows))
+    kept = _SHARED_LISTS.get(key)
+    if kept is None:
+        if len(_SHARED_LISTS) >= _MAX_SHARED_LISTS:
+            _SHARED_LISTS.clear()
+        kept = _SHARED_LISTS[key] = [list(r) for r in rows] if nested else list(rows)
+    return kept
 _FAN = (0.4637, 0.5291)  # interior vertex of every quad (fractions along du, dv)
 _NUDGE_M = np.array([2.0e-4, 3.5e-4, 2.7e-4])  # see _nudge
 _HASH = np.array([[12.9898, 78.233, 37.719], [39.346, 11.135, 83.155], [73.156, 52.235, 9.151]])
@@ -489,10 +508,10 @@ class Builder:
         bc = self.bc
         vis = bc.createVisualShape(
             bc.GEOM_MESH,
-            vertices=_nudge(np.array(verts)).tolist(),
-            indices=idx,
-            uvs=uvs,
-            normals=norms,
+            vertices=_shared_list(_nudge(np.array(verts)).tolist()),
+            indices=_shared_list(idx),
+            uvs=_shared_list(uvs),
+            normals=_shared_list(norms),
             rgbaColor=_rgba(rgb),
         )
         col = -1
