@@ -354,3 +354,15 @@ def test_an_episode_does_not_depend_on_the_episodes_before_it():
     for other in (again, after):
         np.testing.assert_array_equal(first[0], other[0])
         np.testing.assert_array_equal(first[1], other[1])
+
+
+def test_a_lost_physics_server_is_a_clear_error_and_reset_rebuilds_the_world():
+    env = make("vc_gym/AiboRoom-v0")
+    first, _ = env.reset(seed=3)
+    env.unwrapped.client.disconnect()  # as if the server had died
+    with pytest.raises(RuntimeError, match="physics server is gone"):
+        env.step(np.zeros(5, np.float32))
+    again, _ = env.reset(seed=3)  # used to fail: the env had to be made anew
+    np.testing.assert_array_equal(first["image"], again["image"])
+    env.step(np.zeros(5, np.float32))
+    env.close()

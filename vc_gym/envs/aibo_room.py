@@ -239,6 +239,12 @@ class AiboRoomEnv(gym.Env):
         unknown = set(options) - {"pose"}
         if unknown:
             raise ValueError(f"unknown reset options {sorted(unknown)}; known: ['pose']")
+        if self._bc is not None and not self._bc.isConnected():
+            # the physics server is gone (killed, or disconnected by hand): start a new one
+            # and rebuild the world in it, as a fresh env would
+            self._bc = None
+            self._robot = self._scene = self._top_view = None
+            self._scene_key = None
         # the scene depends on the seed only when randomised; rebuild only when it changes
         scene_seed = int(self.np_random.integers(2**31)) if self.randomize else None
         key = (self.scene_name, self.randomize, scene_seed)
@@ -272,6 +278,11 @@ class AiboRoomEnv(gym.Env):
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         self._check_open()
         robot = self.robot
+        if not self.client.isConnected():
+            raise RuntimeError(
+                "the env's physics server is gone (disconnected or killed); call reset() "
+                "to rebuild the world"
+            )
         a = np.asarray(action, dtype=np.float64)
         if a.shape != (5,):
             raise ValueError(f"action must have shape (5,), got {a.shape}")
