@@ -439,6 +439,7 @@ def make_backend(
 
 # --------------------------------------------------------------------------- the run
 
+
 def package_versions() -> dict[str, str]:
     """Versions of Python and the packages whose behaviour the figures depend on."""
     from importlib import metadata

@@ -82,6 +82,8 @@ def _shared_list(rows: list) -> list:
             _SHARED_LISTS.clear()
         kept = _SHARED_LISTS[key] = [list(r) for r in rows] if nested else list(rows)
     return kept
+
+
 _FAN = (0.4637, 0.5291)  # interior vertex of every quad (fractions along du, dv)
 _NUDGE_M = np.array([2.0e-4, 3.5e-4, 2.7e-4])  # see _nudge
 _HASH = np.array([[12.9898, 78.233, 37.719], [39.346, 11.135, 83.155], [73.156, 52.235, 9.151]])
