@@ -1,0 +1,33 @@
+"""vc-gym check: every robustness case passes, and a failing case is reported as failed."""
+
+from __future__ import annotations
+
+import json
+
+from vc_gym.cli import main
+from vc_gym.experiments.check import Case, all_cases, run_check
+
+
+def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
+    out = tmp_path / "check.json"
+    code = main(["check", "--soak-steps", "40", "--soak-cycles", "10", "--out", str(out)])
+    r = json.loads(out.read_text())
+    assert code == 0, r["failures"]
+    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 40
+    assert set(r["suites"]) == {"bad_input", "hostile_file", "fault"}
+    assert r["soak"]["steps"] == 40 and r["soak"]["median_steps_per_s"] > 0
+    assert "failed 0" in capsys.readouterr().out
+
+
+def test_a_case_that_escapes_is_reported():
+    def escapes(_):
+        raise KeyError("not the promised error")
+
+    def passes(_):
+        return None
+
+    r = run_check(
+        20, 10, progress=False, cases=[Case("x", "escapes", escapes), Case("x", "ok", passes)]
+    )
+    assert r["tried"] == 2 and r["failed"] == 1 and r["passed"] == 1
+    assert r["failures"][0]["case"] == "escapes" and "KeyError" in r["failures"][0]["error"]

@@ -1,0 +1,488 @@
+"""``vc-gym check``: bad input, hostile files, faults and a short soak, as one self-test.
+
+Every case does what a careless user, a hostile file or a crashing process would do and
+checks that vc_gym answers with the right result or a clear error of the promised kind
+(``ValueError`` for bad arguments, :class:`~vc_gym.errors.MapFileError` for a file that
+cannot be read, ``RuntimeError`` for a closed env or a lost physics server), that a
+hostile file never runs code or exhausts memory, and that a dead worker ends or retries
+its job within seconds. A case fails if anything else happens: another exception, no
+exception, a hang (each case has a time limit), or code from a file running. The soak
+suite reports the speed and memory figures of a short :func:`~vc_gym.experiments.soak.soak`.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+import os
+import pickle
+import tempfile
+import time
+import traceback
+import zipfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from tqdm import tqdm
+
+import vc_gym  # noqa: F401  (registers the envs)
+from vc_gym.compass import Camera, CompassConfig, VisualCompass
+from vc_gym.errors import MapFileError
+from vc_gym.persistence import load_npz_checked, save_npz_atomic
+
+__all__ = ["Case", "all_cases", "run_check"]
+
+#: A case taking longer than this (seconds) fails as a hang.
+CASE_TIME_LIMIT_S = 60.0
+
+
+@dataclass(frozen=True)
+class Case:
+    """One check: ``run(tmp)`` raises ``AssertionError`` (or anything) when it fails."""
+
+    suite: str
+    name: str
+    run: Callable[[Path], None]
+
+
+def _raises(kind: type[BaseException], match: str, fn: Callable[[], object]) -> None:
+    """``fn()`` must raise ``kind`` whose message contains ``match``."""
+    try:
+        fn()
+    except kind as exc:
+        if match.lower() not in str(exc).lower():
+            raise AssertionError(f"{kind.__name__} without {match!r}: {exc}") from None
+        return
+    raise AssertionError(f"no {kind.__name__} raised")
+
+
+# --------------------------------------------------------------------------- bad input
+def _compass() -> VisualCompass:
+    from vc_gym.worlds.panorama import make_panorama, render_view
+
+    pano = make_panorama(np.random.default_rng(7), width=1200, height=300, kind="room")
+    vc = VisualCompass()
+    vc.fit_colors([render_view(pano, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
+    for a in range(0, 360, 15):
+        vc.learn(render_view(pano, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+    return vc
+
+
+_COMPASS: list[VisualCompass] = []
+
+
+def _learned() -> VisualCompass:
+    if not _COMPASS:
+        _COMPASS.append(_compass())
+    return _COMPASS[0]
+
+
+def _flat_frame(_: Path) -> None:
+    frame = np.zeros((160, 208, 3), np.uint8)
+    ll = _learned().log_likelihood(frame, Camera())
+    assert np.all(ll == 0.0), "an all-black frame must give a flat likelihood"
+
+
+def _kalman_survives(_: Path) -> None:
+    from vc_gym.filters import KalmanHeadingFilter
+
+    f = KalmanHeadingFilter(10.0, 5.0)
+    _raises(ValueError, "spread_deg", lambda: f.update(20.0, 1e-160))
+    _raises(ValueError, "within", lambda: f.predict(10.0, 1e155))
+    f.predict(1.0)
+    f.update(12.0, 2.0)
+    assert np.isfinite(f.estimate().heading_deg)
+
+
+def _room_case(fn: Callable[[gym.Env], None], **kwargs: Any) -> Callable[[Path], None]:
+    def run(_: Path) -> None:
+        env = gym.make("vc_gym/AiboRoom-v0", **kwargs)
+        try:
+            fn(env)
+        finally:
+            env.close()
+
+    return run
+
+
+def _closed_env(_: Path) -> None:
+    env = gym.make("vc_gym/AiboRoom-v0")
+    env.reset(seed=0)
+    env.close()
+    _raises(RuntimeError, "closed", lambda: env.unwrapped.step(np.zeros(5, np.float32)))
+
+
+def _margin(_: Path) -> None:
+    env = gym.make("vc_gym/LearnThenHome-v0", kidnap_margin_m=100.0, learn_time_s=0.2)
+    try:
+        _raises(ValueError, "kidnap_margin_m", lambda: env.reset(seed=0))
+    finally:
+        env.close()
+
+
+def _bad_input_cases() -> list[Case]:
+    from vc_gym.experiments.training import TrainConfig
+    from vc_gym.filters import ParticleFilter, TranslationalFilter
+    from vc_gym.localization import make_tracker
+
+    vc = _learned
+    image = np.zeros((160, 208, 3), np.uint8)
+    spots = np.array([[1.0, 0.0], [-1.0, 0.0]])
+    simple = {
+        "Camera(hfov_deg=True)": lambda: Camera(hfov_deg=True),
+        "Camera(hfov_deg='56.9')": lambda: Camera(hfov_deg="56.9"),
+        "Camera(yaw_deg=1e17)": lambda: Camera(yaw_deg=1e17),
+        "Camera(pitch_deg=90)": lambda: Camera(pitch_deg=90.0),
+        "CompassConfig(coverage=1e-9)": lambda: CompassConfig(coverage=1e-9),
+        "CompassConfig(n_colors=0)": lambda: CompassConfig(n_colors=0),
+        "CompassConfig(sector_deg=7)": lambda: CompassConfig(sector_deg=7.0),
+        "float image": lambda: vc().log_likelihood(image.astype(np.float32), Camera()),
+        "grey image": lambda: vc().log_likelihood(image[:, :, 0], Camera()),
+        "channels first": lambda: vc().log_likelihood(np.zeros((3, 160, 208), np.uint8), Camera()),
+        "camera not a Camera": lambda: vc().log_likelihood(image, "cam"),
+        "particle odometry 1e308": lambda: ParticleFilter(10).predict((1e308, 0.0, 0.0)),
+        "translational predict 1e308": lambda: TranslationalFilter(spots).predict(1e308, 0.0),
+        "goodness all zero": lambda: TranslationalFilter(spots).update([0.0, 0.0]),
+        "illumination=100": lambda: gym.make("vc_gym/AiboRoom-v0", illumination=100.0),
+        "illumination=True": lambda: gym.make("vc_gym/AiboRoom-v0", illumination=True),
+        "scene='nope'": lambda: gym.make("vc_gym/AiboRoom-v0", scene="nope"),
+        "TrainConfig(timesteps=0)": lambda: TrainConfig(timesteps=0),
+        "TrainConfig(algo='dqn')": lambda: TrainConfig(algo="dqn"),
+        "tracker 'nope'": lambda: make_tracker("nope"),
+    }
+    cases = [
+        Case("bad_input", name, lambda _, fn=fn: _raises(ValueError, "", fn))
+        for name, fn in simple.items()
+    ]
+    cases += [
+        Case("bad_input", "all-black frame: flat likelihood", _flat_frame),
+        Case("bad_input", "Kalman: extreme inputs refused, filter still works", _kalman_survives),
+        Case(
+            "bad_input",
+            "pose outside the walls",
+            _room_case(
+                lambda e: _raises(
+                    ValueError, "walls", lambda: e.reset(seed=0, options={"pose": (100, 100, 0)})
+                )
+            ),
+        ),
+        Case(
+            "bad_input",
+            "NaN action",
+            _room_case(
+                lambda e: (
+                    e.reset(seed=0),
+                    _raises(ValueError, "finite", lambda: e.step(np.full(5, np.nan, np.float32))),
+                )
+            ),
+        ),
+        Case(
+            "bad_input",
+            "step before reset",
+            _room_case(
+                lambda e: _raises(RuntimeError, "reset", lambda: e.unwrapped.step(np.zeros(5)))
+            ),
+        ),
+        Case("bad_input", "step after close", _closed_env),
+        Case("bad_input", "kidnap margin larger than the field", _margin),
+    ]
+    return cases
+
+
+# --------------------------------------------------------------------------- hostile files
+def _npy(array: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, array, allow_pickle=True)
+    return buf.getvalue()
+
+
+def _base_entries() -> dict[str, bytes]:
+    return {
+        "schema.npy": _npy(np.array("vc_gym.Check")),
+        "schema_version.npy": _npy(np.array(1, np.int64)),
+    }
+
+
+def _write_zip(path: Path, entries: dict[str, bytes]) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, data in entries.items():
+            zf.writestr(name, data)
+    return path
+
+
+def _refused(path: Path) -> None:
+    _raises(MapFileError, path.name, lambda: load_npz_checked(path, "vc_gym.Check", 1))
+
+
+def _zip_bomb(tmp: Path) -> None:
+    path = tmp / "bomb.npz"
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": (2**25,)}
+    )
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, data in _base_entries().items():
+            zf.writestr(name, data)
+        with zf.open("extra.npy", "w", force_zip64=True) as fh:
+            fh.write(header.getvalue())
+            for _ in range(16):
+                fh.write(bytes(2**24))  # 256 MiB of zeros: ~250 KB compressed
+    t0 = time.perf_counter()
+    _refused(path)
+    assert time.perf_counter() - t0 < 5.0, "the bomb was decompressed"
+
+
+def _huge_shape(tmp: Path) -> None:
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}
+    )
+    _refused(_write_zip(tmp / "shape.npz", {**_base_entries(), "a.npy": header.getvalue()}))
+
+
+def _object_array(tmp: Path) -> None:
+    entries = {**_base_entries(), "a.npy": _npy(np.array([{"x": 1}], dtype=object))}
+    _refused(_write_zip(tmp / "objects.npz", entries))
+
+
+def _bit_flips(tmp: Path) -> None:
+    good = save_npz_atomic(tmp / "good.npz", "vc_gym.Check", 1, {"a": np.arange(50.0)})
+    data = good.read_bytes()
+    for i in range(0, len(data), max(1, len(data) // 40)):
+        flipped = bytearray(data)
+        flipped[i] ^= 0xFF
+        path = tmp / "flipped.npz"
+        path.write_bytes(bytes(flipped))
+        try:
+            load_npz_checked(path, "vc_gym.Check", 1)
+        except MapFileError:
+            pass  # anything else escapes and fails the case
+
+
+def _renamed_npy(tmp: Path) -> None:
+    np.save(tmp / "x.npy", np.zeros(3))
+    (tmp / "x.npy").rename(tmp / "renamed.npz")
+    _refused(tmp / "renamed.npz")
+
+
+def _text_version(tmp: Path) -> None:
+    entries = {**_base_entries(), "schema_version.npy": _npy(np.array("1"))}
+    _refused(_write_zip(tmp / "version.npz", entries))
+
+
+def _deep_map_config(tmp: Path) -> None:
+    arrays = dict(_learned().to_arrays())
+    arrays["config"] = np.array("[" * 50_000 + "]" * 50_000)
+    path = save_npz_atomic(tmp / "deep.npz", "vc_gym.VisualCompass", 1, arrays)
+    _raises(MapFileError, "deep.npz", lambda: VisualCompass.load(path))
+
+
+class _Payload:
+    """Unpickling this creates a file: proof that code from a model file ran."""
+
+    def __init__(self, marker: str):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (open, (self.marker, "w"))
+
+
+def _hostile_model(tmp: Path) -> None:
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+    from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
+
+    marker = tmp / "code-ran"
+    payload = base64.b64encode(pickle.dumps(_Payload(str(marker)))).decode()
+    path = tmp / "model.zip"
+    with zipfile.ZipFile(PRETRAINED_MODEL) as zin, zipfile.ZipFile(path, "w") as zout:
+        for info in zin.infolist():
+            content = zin.read(info.filename)
+            if info.filename == "data":
+                data = json.loads(content)
+                data["lr_schedule"][":serialized:"] = payload
+                data["extra_object"] = {":type:": "<class 'x'>", ":serialized:": payload}
+                content = json.dumps(data).encode()
+            zout.writestr(info.filename, content)
+    _raises(UnsafeModelError, "", lambda: load_sb3_model("ppo", path))
+    assert not marker.exists(), "code from the model file ran"
+
+
+def _settings_file(text: str, name: str) -> Callable[[Path], None]:
+    def run(tmp: Path) -> None:
+        from vc_gym.config_files import read_settings
+
+        path = tmp / name
+        path.write_text(text)
+        _raises(ValueError, name, lambda: read_settings(path))
+
+    return run
+
+
+def _hostile_file_cases() -> list[Case]:
+    return [
+        Case("hostile_file", "npz: 256 MiB zero entry (zip bomb)", _zip_bomb),
+        Case("hostile_file", "npz: header declares 1e6 x 1e6", _huge_shape),
+        Case("hostile_file", "npz: pickled object array", _object_array),
+        Case("hostile_file", "npz: bit flips", _bit_flips),
+        Case("hostile_file", "npz: a renamed .npy", _renamed_npy),
+        Case("hostile_file", "npz: schema_version '1'", _text_version),
+        Case("hostile_file", "map: deeply nested config JSON", _deep_map_config),
+        Case("hostile_file", "model.zip: pickled payload", _hostile_model),
+        Case(
+            "hostile_file",
+            "settings: YAML python tag",
+            _settings_file("algo: !!python/object/apply:os.system ['true']\n", "tag.yml"),
+        ),
+        Case(
+            "hostile_file",
+            "settings: nested 100,000 deep",
+            _settings_file("[" * 100_000 + "]" * 100_000, "deep.json"),
+        ),
+        Case(
+            "hostile_file",
+            "settings: 2 MB file",
+            _settings_file('{"algo": "' + "x" * 2_000_000 + '"}', "big.json"),
+        ),
+    ]
+
+
+# --------------------------------------------------------------------------- faults
+def die_once(marker: str) -> dict[str, Any]:
+    """Job: the worker process dies the first time (as if OOM-killed), succeeds after."""
+    path = Path(marker)
+    if not path.exists():
+        path.write_text("died once")
+        os._exit(9)
+    return {"ok": True}
+
+
+def die_always() -> dict[str, Any]:
+    """Job: the worker process always dies."""
+    os._exit(9)
+
+
+def _runner(tmp: Path, jobs: list, name: str) -> tuple[list, Any]:
+    from vc_gym.experiments.runner import ExperimentRun, LocalBackend
+
+    with LocalBackend(workers=2) as backend:
+        run = ExperimentRun(tmp / name, "check", backend, {"check": name}, progress=False)
+        out = run.run("jobs", jobs)
+        return out, run
+
+
+def _dead_worker_retried(tmp: Path) -> None:
+    from vc_gym.experiments.runner import Job
+
+    jobs = [Job("a", f"{__name__}:die_once", {"marker": str(tmp / "died")})]
+    t0 = time.perf_counter()
+    out, _ = _runner(tmp, jobs, "retry")
+    assert out == [{"ok": True}], f"a job whose worker died once was not retried: {out}"
+    assert time.perf_counter() - t0 < 30.0
+
+
+def _dead_worker_reported(tmp: Path) -> None:
+    from vc_gym.experiments.runner import Job
+
+    t0 = time.perf_counter()
+    out, run = _runner(tmp, [Job("a", f"{__name__}:die_always", {})], "dead")
+    assert out == [None] and run.failures, "a job whose worker always dies must be reported"
+    assert time.perf_counter() - t0 < 30.0
+
+
+def _resumed_run(tmp: Path) -> None:
+    from vc_gym.experiments.runner import Job
+
+    jobs = [Job(f"j{i}", "vc_gym.experiments.check:square", {"x": i}) for i in range(3)]
+    first, _ = _runner(tmp, jobs, "resume")
+    second, run = _runner(tmp, jobs, "resume")
+    assert first == second and run.stages["jobs"]["ran"] == 0, "a finished run ran again"
+
+
+def square(x: float) -> dict[str, Any]:
+    """Job: a figure of ``x``."""
+    return {"x": x, "square": x * x}
+
+
+def _lost_client(_: Path) -> None:
+    env = gym.make("vc_gym/AiboRoom-v0")
+    try:
+        first, _ = env.reset(seed=3)
+        env.unwrapped.client.disconnect()
+        _raises(RuntimeError, "physics server", lambda: env.step(np.zeros(5, np.float32)))
+        again, _ = env.reset(seed=3)
+        assert np.array_equal(first["image"], again["image"]), "reset did not rebuild the world"
+    finally:
+        env.close()
+
+
+def _fault_cases() -> list[Case]:
+    return [
+        Case("fault", "worker killed once: job retried", _dead_worker_retried),
+        Case("fault", "worker always killed: job reported failed", _dead_worker_reported),
+        Case("fault", "finished run rerun: nothing redone", _resumed_run),
+        Case("fault", "physics server lost: clear error, reset rebuilds", _lost_client),
+    ]
+
+
+def all_cases() -> list[Case]:
+    """Every case of every suite (built on demand: some import heavy modules)."""
+    return [*_bad_input_cases(), *_hostile_file_cases(), *_fault_cases()]
+
+
+def run_check(
+    soak_steps: int = 2_000,
+    soak_cycles: int = 30,
+    progress: bool = True,
+    cases: list[Case] | None = None,
+) -> dict[str, Any]:
+    """Run every case (or ``cases``) and a short soak; return the counts, the failures
+    and the soak's figures.
+
+    Returns
+    -------
+    dict
+        ``tried``, ``passed``, ``failed``, ``failures`` (suite, case, error),
+        ``suites`` (tried/passed per suite) and ``soak`` (the soak's figures).
+    """
+    from vc_gym.experiments.soak import soak
+
+    cases = all_cases() if cases is None else list(cases)
+    failures, suites = [], {}
+    with tempfile.TemporaryDirectory(prefix="vc_gym_check_") as tmp:
+        for k, case in enumerate(tqdm(cases, desc="check", disable=not progress)):
+            folder = Path(tmp) / f"case{k}"
+            folder.mkdir()
+            s = suites.setdefault(case.suite, {"tried": 0, "passed": 0})
+            s["tried"] += 1
+            t0 = time.perf_counter()
+            try:
+                case.run(folder)
+                took = time.perf_counter() - t0
+                if took > CASE_TIME_LIMIT_S:
+                    raise AssertionError(f"took {took:.0f} s (limit {CASE_TIME_LIMIT_S:.0f} s)")
+            except Exception as exc:  # noqa: BLE001 - every escape is a failed case
+                failures.append(
+                    {
+                        "suite": case.suite,
+                        "case": case.name,
+                        "error": f"{type(exc).__name__}: {exc}"[:500],
+                        "where": traceback.format_exc(limit=-2)[-600:],
+                    }
+                )
+                continue
+            s["passed"] += 1
+    window = max(10, soak_steps // 4)
+    figures = soak(soak_steps, soak_cycles, window, progress=progress)
+    return {
+        "tried": len(cases),
+        "passed": len(cases) - len(failures),
+        "failed": len(failures),
+        "failures": failures,
+        "suites": suites,
+        "soak": figures,
+    }
