@@ -196,7 +196,10 @@ def _mean_std(values: Sequence[float]) -> list[float]:
 
 def _plot(path: Path, per_agent: dict[str, dict[str, Any]], summary: dict[str, Any]) -> None:
     labels = summary["settings"]["agents"]
-    dists = [[100 * e["home_error_m"] for e in per_agent[a].get("per_episode", [])] for a in labels]
+    dists = [  # cm, floored at 1 cm for the log axis
+        [max(1.0, 100 * e["home_error_m"]) for e in per_agent[a].get("per_episode", [])]
+        for a in labels
+    ]
     fig = new_figure(figsize=(1.6 * len(labels) + 3, 4), layout="constrained")
     ax = fig.subplots()
     rng = np.random.default_rng(0)  # jitter of the dots only
@@ -219,8 +222,9 @@ def _plot(path: Path, per_agent: dict[str, dict[str, Any]], summary: dict[str, A
         ],
         fontsize=8,
     )
-    ax.set_ylabel("stop distance from home (cm); bar: mean")
-    ax.set_yscale("symlog", linthresh=50)
+    ax.set_ylabel("stop distance from home (cm, log); bar: mean")
+    ax.set_yscale("log")
+    ax.set_ylim(1, None)
     s = summary["settings"]
     ax.set_title(
         f"same {len(s['seeds'])} learning seeds × {s['episodes_per_seed']} kidnappings, "
