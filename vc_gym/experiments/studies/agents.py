@@ -22,7 +22,7 @@ import numpy as np
 
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.experiments.studies.common import ExperimentOptions
-from vc_gym.experiments.studies.homing import PAPER_MEAN_CM, PAPER_STD_CM, run_homing
+from vc_gym.experiments.studies.homing import PAPER_MEAN_CM, PAPER_STD_CM, mean_std, run_homing
 
 __all__ = ["agent_list", "run_agents", "summary_lines"]
 
@@ -181,17 +181,11 @@ def _summarise(
     if figures:
         out["learned_over_agents"] = {
             "agents": len(figures),
-            "success_rate": _mean_std([r["success_rate"] for r in figures]),
-            "mean_stop_distance_cm": _mean_std([r["mean_stop_distance_cm"] for r in figures]),
-            "far_stops": _mean_std([r["far_stops"] for r in figures]),
+            "success_rate": mean_std([r["success_rate"] for r in figures]),
+            "mean_stop_distance_cm": mean_std([r["mean_stop_distance_cm"] for r in figures]),
+            "far_stops": mean_std([r["far_stops"] for r in figures]),
         }
     return out
-
-
-def _mean_std(values: Sequence[float]) -> list[float]:
-    """``[mean, std]`` (sample std, ddof 1, as the homing experiment's over seeds)."""
-    v = np.asarray(values, np.float64)
-    return [round(float(v.mean()), 4), round(float(v.std(ddof=1)) if v.size > 1 else 0.0, 4)]
 
 
 def _plot(path: Path, per_agent: dict[str, dict[str, Any]], summary: dict[str, Any]) -> None:

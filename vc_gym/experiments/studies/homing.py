@@ -40,6 +40,7 @@ __all__ = [
     "PAPER_MEAN_CM",
     "PAPER_STD_CM",
     "episode_job",
+    "mean_std",
     "run_homing",
     "spread_over_seeds",
     "summarise_stops",
@@ -194,7 +195,8 @@ def summarise_stops(episodes: Sequence[Mapping[str, Any]], success_radius_m: flo
     }
 
 
-def _mean_std(values: Sequence[float]) -> list[float]:
+def mean_std(values: Sequence[float]) -> list[float]:
+    """``[mean, sample std (ddof 1; 0 for one value)]``, rounded to 4 decimals."""
     v = np.asarray(values, np.float64)
     return [round(float(v.mean()), 4), round(float(v.std(ddof=1)) if v.size > 1 else 0.0, 4)]
 
@@ -202,8 +204,8 @@ def _mean_std(values: Sequence[float]) -> list[float]:
 def spread_over_seeds(per_seed: Sequence[Mapping[str, Any]]) -> dict[str, list[float]]:
     """``[mean, std]`` over learning seeds of :func:`summarise_stops`' success and distance."""
     return {
-        "success_rate_over_seeds": _mean_std([p["success_rate"] for p in per_seed]),
-        "mean_stop_distance_cm_over_seeds": _mean_std(
+        "success_rate_over_seeds": mean_std([p["success_rate"] for p in per_seed]),
+        "mean_stop_distance_cm_over_seeds": mean_std(
             [p["mean_stop_distance_cm"] for p in per_seed]
         ),
     }
