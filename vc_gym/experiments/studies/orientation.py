@@ -12,7 +12,8 @@ estimates (fig. 4 left).
 Modes (:data:`VIEW_MODES`): ``paper`` is the paper's single spot; ``improved`` learns
 the same way at every spot of a grid over the field (:data:`GRID_SPACING_M` apart,
 :class:`~vc_gym.envs.learning.GridLearning`, shared colour classes, home the spot
-nearest the paper's) with exposure-normalised colour classes (so that it holds at half
+nearest the paper's), plus four shorter turns :data:`GRID_AROUND_M` around each spot
+into its map, with exposure-normalised colour classes (so that it holds at half
 light), the trackers take the heading from the map that fits best (eq. 28), and
 distances are measured from the nearest spot; between full scorings the built-in
 trackers score only the three spots that fitted best (:data:`MODE_TRACKER_OPTIONS`), so
