@@ -142,3 +142,18 @@ def test_bad_spot_subsets_are_refused(atlas, room, spots):
     image = render_room_view(room, 0.0, 0.0, Camera())
     with pytest.raises(ValueError, match="spots"):
         atlas.estimate_position(image, Camera(), spots=spots)
+
+
+def test_a_narrow_normalisation_kernel_keeps_the_position_finite(atlas, room):
+    # kernel_deg=0.01 used to underflow every home weight to 0: position (nan, nan)
+    spots = zip(atlas.names, atlas.positions, atlas.compasses, strict=True)
+    fresh = CompassAtlas(
+        {n: (tuple(p), vc) for n, p, vc in spots},
+        home=atlas.home,
+        home_position=atlas.home_position,
+    )
+    homes = [render_room_view(room, 0.0, 0.0, Camera(yaw_deg=a)) for a in (0.0, 120.0, 240.0)]
+    fresh.normalize(homes, [Camera()] * 3, kernel_deg=0.01)
+    est = fresh.estimate_position(render_room_view(room, 0.3, 0.2, Camera(yaw_deg=75.0)), Camera())
+    assert np.all(np.isfinite(est.position))
+    assert all(math.isfinite(g) and g > 0 for g in est.goodness.values())

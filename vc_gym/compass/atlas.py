@@ -264,7 +264,10 @@ class CompassAtlas:
             return np.zeros(which.size)
         home_headings = self._home_headings[:, which]
         d = np.radians(np.asarray(headings_deg)[None, :] - home_headings)
-        w = np.exp(self._kappa * (np.cos(d) - 1.0))  # (frames, spots)
+        logw = self._kappa * (np.cos(d) - 1.0)  # (frames, spots)
+        # relative to the nearest home frame: a narrow kernel no longer underflows every
+        # weight to 0 (0 / 0 made the position NaN); the nearest frame weighs 1
+        w = np.exp(logw - logw.max(axis=0, keepdims=True))
         return (w * self._home_scores[:, which]).sum(axis=0) / w.sum(axis=0)
 
     def estimate_position(
