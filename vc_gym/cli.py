@@ -84,8 +84,8 @@ def _train_sweep(args: argparse.Namespace, config, out: Path) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.runner import check_out_dir
-    from vc_gym.experiments.training import TrainConfig, read_train_config, train
+    from vc_gym.experiments.output import check_out_dir
+    from vc_gym.experiments.training import TrainConfig, check_names, read_train_config, train
 
     given = {
         field: getattr(args, opt)
@@ -108,11 +108,12 @@ def _cmd_train(args: argparse.Namespace) -> int:
         out = Path(args.resume)
         config = read_train_config(out / "config.json", **given)
     else:
-        out = check_out_dir(args.out or "vc_gym_agent")
         if args.config:
             config = read_train_config(args.config, **given)
         else:
             config = TrainConfig(**given)
+        check_names(config)  # a bad scene or tracker fails before the folder is made
+        out = check_out_dir(args.out or "vc_gym_agent")
     if args.seeds is not None:
         return _train_sweep(args, config, out)
     s = train(

@@ -264,3 +264,15 @@ def test_agents_experiment_compares_on_the_same_kidnappings(trained, tmp_path, c
     assert f"{label} vs scripted" in capsys.readouterr().out
     bad = ["experiment", "agents", "--quick", "--agent", model, "--out", str(tmp_path / "x")]
     assert main(bad) == 2 and "'scripted'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("field", "value"), [("scene", "nope"), ("tracker", "nope")])
+def test_a_bad_scene_or_tracker_in_a_config_file_fails_before_the_run_folder(
+    tmp_path, capsys, field, value
+):
+    # used to crash the workers and leave a folder behind
+    cfg = tmp_path / "bad.json"
+    cfg.write_text(json.dumps({field: value, "timesteps": 64}))
+    out = tmp_path / "run"
+    assert main(["train", "--config", str(cfg), "--out", str(out)]) == 2
+    assert value in capsys.readouterr().err and not out.exists()

@@ -24,12 +24,14 @@ from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
 from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
+from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
+from vc_gym.localization import make_tracker
 from vc_gym.persistence import write_atomic
 from vc_gym.validation import int_at_least, positive_float
 
-__all__ = ["TrainConfig", "read_train_config", "train"]
+__all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
 
 CONFIG_SCHEMA = 2
 #: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
@@ -214,6 +216,12 @@ def training_env(config: TrainConfig, atlas_file: str | os.PathLike) -> gym.Env:
     )
 
 
+def check_names(config: TrainConfig) -> None:
+    """Refuse an unregistered scene or tracker of ``config`` with a clear ``ValueError``."""
+    check_scene_name(config.scene)
+    make_tracker(config.tracker)
+
+
 def learn_place(config: TrainConfig, atlas_file: str | os.PathLike) -> bool:
     """Run the learning phase of ``config``'s env once, into ``atlas_file`` (kept if it is
     there already and was learned the same way). Returns whether it learned."""
@@ -331,6 +339,7 @@ def train(
 
     out = Path(out_dir)
     algo = algorithm_class(config.algo)
+    check_names(config)  # before the run folder is made, not in the workers
     if tensorboard_log is not None:
         try:
             import tensorboard  # noqa: F401
