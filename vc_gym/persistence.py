@@ -12,7 +12,7 @@ import json
 import os
 import tempfile
 import zipfile
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +27,7 @@ __all__ = [
     "read_json_array",
     "save_npz_atomic",
     "write_atomic",
+    "zip_entries_problem",
 ]
 
 
@@ -199,20 +200,39 @@ def load_npz_checked(
     return arrays
 
 
+def zip_entries_problem(
+    infos: Sequence[zipfile.ZipInfo], max_entry: int, max_total: int
+) -> str | None:
+    """What makes a zip unsafe to open, judged from its directory alone (nothing is
+    decompressed): a repeated entry name (a second entry hiding behind the first), an
+    entry larger than ``max_entry`` bytes or more than ``max_total`` in all. ``None``
+    if there is nothing; maps (:func:`load_npz_checked`) and models
+    (:mod:`vc_gym.agents.safe_load`) are both checked with it."""
+    seen: set[str] = set()
+    for info in infos:
+        if info.filename in seen:
+            return f"entry {info.filename!r} is repeated (it appears twice)"
+        seen.add(info.filename)
+        if info.file_size > max_entry:
+            return f"entry {info.filename!r} is larger than {max_entry} bytes"
+    total = sum(i.file_size for i in infos)
+    if total > max_total:
+        return f"its entries hold {total} bytes, more than {max_total}"
+    return None
+
+
 def _read_entries(path: Path, max_entry: int, max_total: int) -> dict[str, np.ndarray]:
     """The arrays of the zip at ``path``, each checked before it is decompressed."""
     arrays: dict[str, np.ndarray] = {}
     with zipfile.ZipFile(path) as zf:
         infos = zf.infolist()
-        total = sum(i.file_size for i in infos)
-        if total > max_total:
-            raise MapFileError(f"{path}: its entries hold {total} bytes, more than {max_total}")
+        problem = zip_entries_problem(infos, max_entry, max_total)
+        if problem is not None:
+            raise MapFileError(f"{path}: {problem}")
         for info in infos:
             name = info.filename
-            if not name.endswith(".npy") or name[:-4] in arrays:
-                raise MapFileError(f"{path}: unexpected or repeated entry {name!r}")
-            if info.file_size > max_entry:
-                raise MapFileError(f"{path}: entry {name!r} is larger than {max_entry} bytes")
+            if not name.endswith(".npy"):
+                raise MapFileError(f"{path}: unexpected entry {name!r}")
             with zf.open(info) as fh:
                 major, minor = np.lib.format.read_magic(fh)
                 read_header = (

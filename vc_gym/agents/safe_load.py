@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.persistence import zip_entries_problem
+
 __all__ = ["MAX_ENTRY_BYTES", "MAX_MODEL_BYTES", "UnsafeModelError", "load_sb3_model"]
 
 #: Largest uncompressed size of one entry of a model zip, and of all entries together.
@@ -113,20 +115,17 @@ def _checked_data(path: Path) -> dict[str, Any]:
     try:
         with zipfile.ZipFile(path) as z:
             infos = z.infolist()
+            problem = zip_entries_problem(infos, MAX_ENTRY_BYTES, MAX_MODEL_BYTES)
+            if problem is not None:
+                raise UnsafeModelError(problem)
             names = {i.filename for i in infos}
             unknown = names - _ENTRIES
-            if len(names) != len(infos):
-                raise UnsafeModelError("an entry name appears twice")
             if unknown or "data" not in names or "policy.pth" not in names:
                 raise UnsafeModelError(
                     f"unexpected entries {sorted(unknown)}"
                     if unknown
                     else "no 'data' or 'policy.pth' entry"
                 )
-            if any(i.file_size > MAX_ENTRY_BYTES for i in infos) or (
-                sum(i.file_size for i in infos) > MAX_MODEL_BYTES
-            ):
-                raise UnsafeModelError("larger than a homing policy can be")
             text = z.read("data").decode("utf-8")
     except (OSError, zipfile.BadZipFile, UnicodeDecodeError, KeyError) as exc:
         raise UnsafeModelError(f"not a readable model zip: {exc}") from None
