@@ -206,6 +206,19 @@ class AiboRoomEnv(gym.Env):
         """``(scene, randomize, scene seed)`` of the built scene: changes when it is rebuilt."""
         return self._scene_key
 
+    def inside_walls(self, x: float, y: float) -> bool:
+        """Whether a robot centred at ``(x, y)`` stands at least ``ROBOT_CLEARANCE_M``
+        inside the walls of the built scene (after :meth:`reset`): where it may be put."""
+        rx0, rx1, ry0, ry1 = self.scene.room_bounds
+        c = ROBOT_CLEARANCE_M
+        return rx0 + c <= x <= rx1 - c and ry0 + c <= y <= ry1 - c
+
+    def walls_text(self) -> str:
+        """Where :meth:`inside_walls` holds, for error messages."""
+        rx0, rx1, ry0, ry1 = self.scene.room_bounds
+        c = ROBOT_CLEARANCE_M
+        return f"x {rx0 + c:g}..{rx1 - c:g}, y {ry0 + c:g}..{ry1 - c:g} m"
+
     def _check_open(self) -> None:
         if self._closed:
             raise RuntimeError("this AiboRoomEnv is closed; make a new one")
@@ -255,12 +268,10 @@ class AiboRoomEnv(gym.Env):
             x, y, yaw = (float(v) for v in options["pose"])
             if not all(math.isfinite(v) for v in (x, y, yaw)):
                 raise ValueError(f"pose must be 3 finite numbers, got {options['pose']!r}")
-            rx0, rx1, ry0, ry1 = self.scene.room_bounds
-            c = ROBOT_CLEARANCE_M
-            if not (rx0 + c <= x <= rx1 - c and ry0 + c <= y <= ry1 - c):
+            if not self.inside_walls(x, y):
                 raise ValueError(
                     f"pose {options['pose']!r} is not inside the walls of {self.scene_name!r} "
-                    f"(x {rx0 + c:g}..{rx1 - c:g}, y {ry0 + c:g}..{ry1 - c:g} m)"
+                    f"({self.walls_text()})"
                 )
         else:
             fx0, fx1, fy0, fy1 = self.scene.field_bounds

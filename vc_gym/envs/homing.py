@@ -99,8 +99,11 @@ class StopAction(gym.Wrapper):
         inner = env.action_space
         if not isinstance(inner, spaces.Box) or inner.shape[0] < 5:
             raise ValueError(f"StopAction needs the task's Box(5) actions, got {inner}")
-        if not hasattr(env.unwrapped, "velocity_action"):
-            raise ValueError("StopAction wraps vc_gym/LearnThenHome-v0 (its velocity_action)")
+        task = env.unwrapped
+        if not all(hasattr(task, k) for k in ("velocity_action", "is_still", "still_threshold")):
+            raise ValueError(
+                "StopAction wraps vc_gym/LearnThenHome-v0 (its velocity_action and stop rule)"
+            )
         self.max_forward = positive_float("max_forward", max_forward)
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
         nonnegative_float("min_walk_s", min_walk_s)
@@ -127,9 +130,9 @@ class StopAction(gym.Wrapper):
     def _walk_action(self, forward: float, turn: float) -> np.ndarray:
         """The task action of a walk decision, never one the task counts as standing still."""
         a = self._inner_action(forward, turn)
-        threshold = float(getattr(self.env.unwrapped, "still_threshold", 0.0))
-        if np.all(np.abs(a[:3]) <= threshold):
-            a[2] = np.float32(np.copysign(min(2.0 * threshold, 1.0), turn))
+        task = self.env.unwrapped
+        if task.is_still(a):
+            a[2] = np.float32(np.copysign(min(2.0 * task.still_threshold, 1.0), turn))
         return a
 
     def step(self, action):

@@ -13,7 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.envs.aibo_room import ROBOT_CLEARANCE_M, AiboRoomEnv
+from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.envs.learning import (
     HOME,
@@ -23,6 +23,7 @@ from vc_gym.envs.learning import (
     RobotFell,
     ScriptedLearning,
     kidnap_pose,
+    paper_spots,
 )
 from vc_gym.poses import compose
 from vc_gym.validation import int_at_least, nonnegative_float, positive_float
@@ -267,6 +268,12 @@ class LearnThenHomeEnv(gym.Env):
             "still_time_s": self._still_steps * self.control_dt,
         }
 
+    def is_still(self, action: np.ndarray) -> bool:
+        """Whether ``action`` commands no body motion (``|forward|``, ``|sideways|``,
+        ``|turn|`` all ≤ ``still_threshold``; the head may move): the stop rule counts
+        such steps."""
+        return bool(np.all(np.abs(np.asarray(action)[:3]) <= self.still_threshold))
+
     def velocity_action(self, **velocities: float) -> np.ndarray:
         """The room's :meth:`~vc_gym.envs.AiboRoomEnv.velocity_action` (``Box(5)``)."""
         return self.room.velocity_action(**velocities)
@@ -293,15 +300,11 @@ class LearnThenHomeEnv(gym.Env):
                 f"field of {self.room.scene_name!r} (it must be < {side / 2:g})"
             )
         if self.learning == "scripted":
-            rx0, rx1, ry0, ry1 = self.room.scene.room_bounds
-            d, c = self.learn_config.spot_distance_m, ROBOT_CLEARANCE_M
-            hx, hy = HOME
-            if not (
-                rx0 + c < hx - d and hx + d < rx1 - c and ry0 + c < hy - d and hy + d < ry1 - c
-            ):
+            d = self.learn_config.spot_distance_m
+            if not all(self.room.inside_walls(x, y) for x, y in paper_spots(d).values()):
                 raise ValueError(
                     f"spot_distance_m={d} puts the learning spots outside the walls of "
-                    f"{self.room.scene_name!r} (room x {rx0:g}..{rx1:g}, y {ry0:g}..{ry1:g} m)"
+                    f"{self.room.scene_name!r} ({self.room.walls_text()})"
                 )
 
     # ------------------------------------------------------------------ gym API
@@ -375,8 +378,7 @@ class LearnThenHomeEnv(gym.Env):
         d = self._home_distance(info)
         reward = self.progress_reward * (self._distance - d)
         self._distance = d
-        still = bool(np.all(np.abs(a[:3]) <= self.still_threshold))
-        self._still_steps = self._still_steps + 1 if still else 0
+        self._still_steps = self._still_steps + 1 if self.is_still(a) else 0
         stopped = self._still_steps * self.control_dt >= self.stop_time_s - 1e-9
         terminated = fell or stopped
         truncated = not terminated and self._phase_time >= self.max_homing_s - 1e-9

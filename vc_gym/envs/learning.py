@@ -26,7 +26,7 @@ from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
-from vc_gym.validation import finite_float, nonnegative_float, positive_float
+from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
 
 __all__ = [
     "HEAD_SCAN_DEG",
@@ -39,6 +39,7 @@ __all__ = [
     "RobotFell",
     "ScriptedLearner",
     "ScriptedLearning",
+    "paper_spots",
     "SpotLearning",
     "GridLearning",
     "kidnap_pose",
@@ -138,6 +139,13 @@ class LearningResult:
 Learner = Callable[..., LearningResult]
 
 
+def paper_spots(spot_distance_m: float) -> dict[str, tuple[float, float]]:
+    """The paper's four training spots ``spot_distance_m`` east, north, west and south of
+    home (the world origin), by name (5.2)."""
+    d = float(spot_distance_m)
+    return {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
+
+
 class ScriptedLearner:
     """The paper's learning behaviour on a ``vc_gym/AiboRoom-v0`` env (4.3, 5.2).
 
@@ -224,8 +232,7 @@ class ScriptedLearner:
 
     def spots(self) -> dict[str, tuple[float, float]]:
         """The four training spots around home (world metres)."""
-        d = self.config.spot_distance_m
-        return {"east": (d, 0.0), "north": (0.0, d), "west": (-d, 0.0), "south": (0.0, -d)}
+        return paper_spots(self.config.spot_distance_m)
 
     def steps_per_direction(self) -> int:
         """Frames learned per direction: ``learn_time_s`` at the room's control rate."""
@@ -520,13 +527,9 @@ class GridLearning:
             raise ValueError(f"spots must be 1 to 64 distinct (x, y) pairs, got {len(pts)}")
         self.spots = pts
         self.around_m = nonnegative_float("around_m", around_m)
-        if around_steps is not None and (
-            isinstance(around_steps, bool)
-            or not isinstance(around_steps, (int, np.integer))
-            or around_steps < 1
-        ):
-            raise ValueError(f"around_steps must be an int >= 1 or None, got {around_steps!r}")
-        self.around_steps = None if around_steps is None else int(around_steps)
+        self.around_steps = (
+            None if around_steps is None else int_at_least("around_steps", around_steps, 1)
+        )
 
     def __repr__(self) -> str:
         extra = f", around_m={self.around_m}" if self.around_m else ""
