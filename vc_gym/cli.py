@@ -84,7 +84,6 @@ def _train_sweep(args: argparse.Namespace, config, out: Path) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.output import check_out_dir
     from vc_gym.experiments.training import TrainConfig, check_names, read_train_config, train
 
     given = {
@@ -113,7 +112,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         else:
             config = TrainConfig(**given)
         check_names(config)  # a bad scene or tracker fails before the folder is made
-        out = check_out_dir(args.out or "vc_gym_agent")
+        out = Path(args.out or "vc_gym_agent")  # train and the sweep's run check it first
     if args.seeds is not None:
         return _train_sweep(args, config, out)
     s = train(
