@@ -13,6 +13,7 @@ suite reports the speed and memory figures of a short :func:`~vc_gym.experiments
 from __future__ import annotations
 
 import base64
+import functools
 import io
 import json
 import os
@@ -31,9 +32,18 @@ import numpy as np
 from tqdm import tqdm
 
 import vc_gym  # noqa: F401  (registers the envs)
+from vc_gym.agents.learned import PRETRAINED_MODEL
+from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
 from vc_gym.compass import Camera, CompassConfig, VisualCompass
+from vc_gym.config_files import read_settings
 from vc_gym.errors import MapFileError
+from vc_gym.experiments.runner import ExperimentRun, Job, LocalBackend
+from vc_gym.experiments.soak import soak
+from vc_gym.experiments.training import TrainConfig
+from vc_gym.filters import KalmanHeadingFilter, ParticleFilter, TranslationalFilter
+from vc_gym.localization import make_tracker
 from vc_gym.persistence import load_npz_checked, save_npz_atomic
+from vc_gym.worlds.panorama import make_panorama, render_view
 
 __all__ = ["Case", "all_cases", "run_check"]
 
@@ -62,24 +72,15 @@ def _raises(kind: type[BaseException], match: str, fn: Callable[[], object]) -> 
 
 
 # --------------------------------------------------------------------------- bad input
-def _compass() -> VisualCompass:
-    from vc_gym.worlds.panorama import make_panorama, render_view
-
+@functools.cache
+def _learned() -> VisualCompass:
+    """A compass learned on a synthetic room panorama (built once per process)."""
     pano = make_panorama(np.random.default_rng(7), width=1200, height=300, kind="room")
     vc = VisualCompass()
     vc.fit_colors([render_view(pano, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
     for a in range(0, 360, 15):
         vc.learn(render_view(pano, Camera(yaw_deg=a)), Camera(yaw_deg=a))
     return vc
-
-
-_COMPASS: list[VisualCompass] = []
-
-
-def _learned() -> VisualCompass:
-    if not _COMPASS:
-        _COMPASS.append(_compass())
-    return _COMPASS[0]
 
 
 def _flat_frame(_: Path) -> None:
@@ -89,7 +90,6 @@ def _flat_frame(_: Path) -> None:
 
 
 def _kalman_survives(_: Path) -> None:
-    from vc_gym.filters import KalmanHeadingFilter
 
     f = KalmanHeadingFilter(10.0, 5.0)
     _raises(ValueError, "spread_deg", lambda: f.update(20.0, 1e-160))
@@ -110,6 +110,11 @@ def _room_case(fn: Callable[[gym.Env], None], **kwargs: Any) -> Callable[[Path],
     return run
 
 
+def _nan_action(env: gym.Env) -> None:
+    env.reset(seed=0)
+    _raises(ValueError, "finite", lambda: env.step(np.full(5, np.nan, np.float32)))
+
+
 def _closed_env(_: Path) -> None:
     env = gym.make("vc_gym/AiboRoom-v0")
     env.reset(seed=0)
@@ -126,9 +131,6 @@ def _margin(_: Path) -> None:
 
 
 def _bad_input_cases() -> list[Case]:
-    from vc_gym.experiments.training import TrainConfig
-    from vc_gym.filters import ParticleFilter, TranslationalFilter
-    from vc_gym.localization import make_tracker
 
     vc = _learned
     image = np.zeros((160, 208, 3), np.uint8)
@@ -174,12 +176,7 @@ def _bad_input_cases() -> list[Case]:
         Case(
             "bad_input",
             "NaN action",
-            _room_case(
-                lambda e: (
-                    e.reset(seed=0),
-                    _raises(ValueError, "finite", lambda: e.step(np.full(5, np.nan, np.float32))),
-                )
-            ),
+            _room_case(_nan_action),
         ),
         Case(
             "bad_input",
@@ -293,8 +290,6 @@ class _Payload:
 
 
 def _hostile_model(tmp: Path) -> None:
-    from vc_gym.agents.learned import PRETRAINED_MODEL
-    from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
 
     marker = tmp / "code-ran"
     payload = base64.b64encode(pickle.dumps(_Payload(str(marker)))).decode()
@@ -314,7 +309,6 @@ def _hostile_model(tmp: Path) -> None:
 
 def _settings_file(text: str, name: str) -> Callable[[Path], None]:
     def run(tmp: Path) -> None:
-        from vc_gym.config_files import read_settings
 
         path = tmp / name
         path.write_text(text)
@@ -367,7 +361,6 @@ def die_always() -> dict[str, Any]:
 
 
 def _runner(tmp: Path, jobs: list, name: str) -> tuple[list, Any]:
-    from vc_gym.experiments.runner import ExperimentRun, LocalBackend
 
     with LocalBackend(workers=2) as backend:
         run = ExperimentRun(tmp / name, "check", backend, {"check": name}, progress=False)
@@ -376,7 +369,6 @@ def _runner(tmp: Path, jobs: list, name: str) -> tuple[list, Any]:
 
 
 def _dead_worker_retried(tmp: Path) -> None:
-    from vc_gym.experiments.runner import Job
 
     jobs = [Job("a", f"{__name__}:die_once", {"marker": str(tmp / "died")})]
     t0 = time.perf_counter()
@@ -386,7 +378,6 @@ def _dead_worker_retried(tmp: Path) -> None:
 
 
 def _dead_worker_reported(tmp: Path) -> None:
-    from vc_gym.experiments.runner import Job
 
     t0 = time.perf_counter()
     out, run = _runner(tmp, [Job("a", f"{__name__}:die_always", {})], "dead")
@@ -395,7 +386,6 @@ def _dead_worker_reported(tmp: Path) -> None:
 
 
 def _resumed_run(tmp: Path) -> None:
-    from vc_gym.experiments.runner import Job
 
     jobs = [Job(f"j{i}", "vc_gym.experiments.check:square", {"x": i}) for i in range(3)]
     first, _ = _runner(tmp, jobs, "resume")
@@ -449,7 +439,6 @@ def run_check(
         ``tried``, ``passed``, ``failed``, ``failures`` (suite, case, error),
         ``suites`` (tried/passed per suite) and ``soak`` (the soak's figures).
     """
-    from vc_gym.experiments.soak import soak
 
     cases = all_cases() if cases is None else list(cases)
     failures, suites = [], {}
