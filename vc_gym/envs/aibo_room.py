@@ -287,13 +287,22 @@ class AiboRoomEnv(gym.Env):
     def step(
         self, action: np.ndarray
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        try:
+            return self._step(action)
+        except pybullet.error:
+            # asked only when PyBullet fails, so a step pays nothing for the check
+            if self._bc is not None and not self._bc.isConnected():
+                raise RuntimeError(
+                    "the env's physics server is gone (disconnected or killed); call "
+                    "reset() to rebuild the world"
+                ) from None
+            raise
+
+    def _step(
+        self, action: np.ndarray
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         self._check_open()
         robot = self.robot
-        if not self.client.isConnected():
-            raise RuntimeError(
-                "the env's physics server is gone (disconnected or killed); call reset() "
-                "to rebuild the world"
-            )
         a = np.asarray(action, dtype=np.float64)
         if a.shape != (5,):
             raise ValueError(f"action must have shape (5,), got {a.shape}")
