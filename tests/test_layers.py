@@ -25,6 +25,7 @@ BASE = {
     "config_files",
     "errors",
     "exposure",
+    "plugins",
     "poses",
 }
 ORDER = [

@@ -19,6 +19,7 @@ __all__ = [
     "circular_std",
     "circular_std_rows",
     "interp_circular",
+    "peak_headings",
 ]
 
 
@@ -105,6 +106,42 @@ def circular_std_rows(angle_deg: ArrayLike, weights: ArrayLike) -> np.ndarray:
         raise ValueError("weights must be finite, non-negative and not all zero in a row")
     r = np.hypot((w * np.sin(a)).sum(axis=1), (w * np.cos(a)).sum(axis=1)) / w.sum(axis=1)
     return np.array([_std_from_resultant(float(v)) for v in r])
+
+
+def peak_headings(log_likelihoods: ArrayLike, step_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """Best heading of each row of a log-likelihood on a circular grid, refined.
+
+    The arg-max of each row, moved by the vertex of the parabola through it and its two
+    neighbours (at most half a step; not moved where the three do not curve down).
+
+    Parameters
+    ----------
+    log_likelihoods : array_like
+        ``(M, N)`` log-likelihoods at ``0, step, ..., (N - 1) step`` degrees.
+    step_deg : float
+        Grid step in degrees.
+
+    Returns
+    -------
+    headings : numpy.ndarray
+        ``(M,)`` refined best headings in ``[0, 360)``.
+    best : numpy.ndarray
+        ``(M,)`` index of each row's grid maximum.
+    """
+    lls = np.asarray(log_likelihoods, dtype=np.float64)
+    if lls.ndim != 2 or lls.shape[1] == 0:
+        raise ValueError(f"peak_headings needs (M, N) log-likelihoods, got shape {lls.shape}")
+    m, n = lls.shape
+    rows = np.arange(m)
+    best = np.argmax(lls, axis=1)
+    y0, y1, y2 = lls[rows, (best - 1) % n], lls[rows, best], lls[rows, (best + 1) % n]
+    with np.errstate(invalid="ignore"):  # -inf neighbours: no refinement
+        denom = y0 - 2.0 * y1 + y2
+        peaked = np.isfinite(denom) & (denom < 0)
+    frac = np.zeros(m)
+    frac[peaked] = 0.5 * (y0[peaked] - y2[peaked]) / denom[peaked]
+    heading = np.mod(best * step_deg + np.clip(frac, -0.5, 0.5) * step_deg, 360.0)
+    return heading, best
 
 
 def _std_from_resultant(r: float) -> float:

@@ -293,6 +293,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "mode": getattr(args, "mode", None),
         "modes": getattr(args, "modes", None),
         "light": getattr(args, "light", None),
+        "data_dir": getattr(args, "data", None),
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -307,9 +308,11 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         if value is None:
             continue
         if name not in accepted:
-            flag = "--" + {"learn_time_s": "learn-time", "max_homing_s": "max-homing"}.get(
-                name, name
-            )
+            flag = "--" + {
+                "learn_time_s": "learn-time",
+                "max_homing_s": "max-homing",
+                "data_dir": "data",
+            }.get(name, name)
             raise ValueError(f"experiment {args.name} does not take {flag}")
         options[name] = value
     return options
@@ -887,7 +890,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="orientation, environments: room illumination for the views, in (0, 1] "
         "(maps learned at full light; the paper's 5.3: 0.5)",
     )
-    p.add_argument("--data", metavar="DIR", help="real-rotation: folder of the photo sets")
+    p.add_argument(
+        "--data", metavar="DIR", help="real-rotation, sensors: folder of the real photo sets"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     p.set_defaults(func=_cmd_experiment)
     return parser

@@ -82,6 +82,33 @@ def test_orientation_reports_every_tracker_by_distance(paper_quick):
         assert t["by_distance"] and sum(b["n"] for b in t["by_distance"]) == robolab["views"]
 
 
+def test_sensors_compares_every_sensor_on_the_same_views(paper_quick):
+    from vc_gym.experiments.real_data import default_real_data_dir
+    from vc_gym.experiments.studies.sensors import DISTANCES_M, LIGHTS, SENSORS
+
+    r = json.loads((paper_quick / "sensors" / "results.json").read_text())
+    sim = r["simulated"]["sensors"]
+    assert set(sim) == set(SENSORS)
+    for name, per in sim.items():
+        assert set(per["scenes"]) == set(r["settings"]["scenes"]), name
+        for light in LIGHTS:
+            at_spot = per["all_scenes"][f"0m_light{light:g}"]
+            assert at_spot["n"] == 2 * len(r["settings"]["scenes"])  # quick: 2 views a scene
+            assert at_spot["median_abs_error_deg"] <= at_spot["p90_abs_error_deg"]
+        assert {k.split("m_")[0] for k in per["all_scenes"]} <= {f"{d:g}" for d in DISTANCES_M}
+    # at the spot in full light every image sensor knows its heading
+    for name in ("visual_compass_improved", "image_difference", "feature", "sector_colour"):
+        assert sim[name]["all_scenes"]["0m_light1"]["median_abs_error_deg"] < 5.0, name
+    if default_real_data_dir() is not None:
+        assert set(r["real"]) == {"rotation_grail", "rotation_parrington"}
+        assert "magnetic" not in r["real"]["rotation_grail"]  # it reads no photo
+        assert r["real"]["rotation_grail"]["feature"]["median_abs_error_deg"] < 5.0
+    cost = json.loads((paper_quick / "sensors" / "run.json").read_text())
+    ms = cost["ms_per_frame_median"]["views"]
+    assert {f"{n}/localise" for n in SENSORS} <= set(ms)
+    assert "magnetometer" in (paper_quick / "report.md").read_text()
+
+
 def test_homing_results_and_video(homing_quick):
     r = json.loads((homing_quick / "results.json").read_text())
     assert [e["seed"] for e in r["per_episode"]] == [1, 2]

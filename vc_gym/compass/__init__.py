@@ -14,6 +14,7 @@ from vc_gym.compass.camera import AIBO_HFOV_DEG, AIBO_RESOLUTION, Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.features import log2_bin
+from vc_gym.compass.protocol import ImageCompass
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
 from vc_gym.errors import MapFileError, NotLearnedError
 
@@ -26,6 +27,7 @@ __all__ = [
     "CompassAtlas",
     "CompassConfig",
     "CompassEstimate",
+    "ImageCompass",
     "MapFileError",
     "NotLearnedError",
     "VisualCompass",

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vc_gym.angles import circular_std_rows, wrap360
+from vc_gym.angles import circular_std_rows, peak_headings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
@@ -720,17 +720,9 @@ def _estimates_of(
     """
     first = compasses[0]
     headings = first._headings
-    m, n_h = lls.shape
-    rows = np.arange(m)
-    best = np.argmax(lls, axis=1)
-    y0, y1, y2 = lls[rows, (best - 1) % n_h], lls[rows, best], lls[rows, (best + 1) % n_h]
-    denom = y0 - 2.0 * y1 + y2
-    peaked = denom < 0
-    frac = np.zeros(m)
-    frac[peaked] = 0.5 * (y0[peaked] - y2[peaked]) / denom[peaked]
-    step = first.config.heading_step_deg
-    heading = wrap360(headings[best] + np.clip(frac, -0.5, 0.5) * step)
-    spread = circular_std_rows(headings, np.exp(lls - y1[:, None]))
+    m = lls.shape[0]
+    heading, best = peak_headings(lls, first.config.heading_step_deg)
+    spread = circular_std_rows(headings, np.exp(lls - lls[np.arange(m), best][:, None]))
     scores, n_sectors = _scores_at(compasses, geom, counts, total, best)
     return [
         CompassEstimate(float(heading[k]), float(spread[k]), scores[k], n_sectors[k], lls[k])

@@ -9,15 +9,18 @@ length and optical axis (its principal point moves), so its true yaw is the phot
 from __future__ import annotations
 
 import os
+import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from vc_gym.angles import wrap180
-from vc_gym.compass import Camera, CompassConfig, VisualCompass
+from vc_gym.compass import Camera, CompassConfig, ImageCompass, VisualCompass
 from vc_gym.experiments.real_data import ROTATION_SETS, RotationPhoto, load_rotation_set
 
-__all__ = ["evaluate_rotation_set", "run_real_rotation", "crop_columns"]
+__all__ = ["crop_columns", "evaluate_rotation_set", "rotation_set_errors", "run_real_rotation"]
 
 
 def crop_columns(photo: RotationPhoto, left: int, width: int) -> tuple[np.ndarray, Camera]:
@@ -35,6 +38,78 @@ def crop_columns(photo: RotationPhoto, left: int, width: int) -> tuple[np.ndarra
     return crop, cam
 
 
+def _learn_all(sensor: ImageCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
+    for image, camera in frames:
+        sensor.learn(image, camera)
+
+
+def rotation_set_errors(
+    photos: list[RotationPhoto],
+    sensor: ImageCompass,
+    prepare: Callable[[ImageCompass, list[tuple[np.ndarray, Camera]]], None] | None = None,
+    crop_width_frac: float = 0.5,
+    crops_per_photo: int = 3,
+) -> dict[str, Any]:
+    """Teach ``sensor`` the even photos, then estimate the yaw of crops of the odd ones.
+
+    Parameters
+    ----------
+    photos : list of RotationPhoto
+        One rotation set (at least 4 photos).
+    sensor : ImageCompass
+        A fresh sensor (the visual compass or a baseline).
+    prepare : callable, optional
+        ``prepare(sensor, [(image, camera), ...])`` teaches it the training photos
+        (default: ``sensor.learn`` on each; a visual compass also needs its colours).
+    crop_width_frac : float
+        Width of a crop as a fraction of the photo's.
+    crops_per_photo : int
+        Crops per test photo, spread from the left to the right edge.
+
+    Returns
+    -------
+    dict
+        ``errors_deg`` and ``crops`` per crop, ``n_train``, and the milliseconds per
+        frame to learn (``learn_ms``) and to estimate (``localise_ms``, median).
+    """
+    if len(photos) < 4:
+        raise ValueError(f"need at least 4 photos, got {len(photos)}")
+    train, test = photos[0::2], photos[1::2]
+    frames = [
+        (p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg)) for p in train
+    ]
+    t0 = time.perf_counter()
+    (prepare or _learn_all)(sensor, frames)
+    learn_ms = 1e3 * (time.perf_counter() - t0) / len(frames)
+    errors, crops, cost = [], [], []
+    for p in test:
+        w = p.image.shape[1]
+        cw = max(2, int(round(w * crop_width_frac)))
+        for left in np.linspace(0, w - cw, crops_per_photo).round().astype(int):
+            crop, cam = crop_columns(p, int(left), cw)
+            t0 = time.perf_counter()
+            est = sensor.estimate(crop, cam)
+            cost.append(1e3 * (time.perf_counter() - t0))
+            errors.append(abs(float(wrap180(est.heading_deg - p.yaw_deg))))
+            crops.append(
+                {
+                    "photo": p.name,
+                    "left": int(left),
+                    "width": cw,
+                    "true_yaw_deg": p.yaw_deg,
+                    "estimate_deg": est.heading_deg,
+                    "spread_deg": est.spread_deg,
+                }
+            )
+    return {
+        "errors_deg": errors,
+        "crops": crops,
+        "n_train": len(train),
+        "learn_ms": learn_ms,
+        "localise_ms": float(np.median(cost)),
+    }
+
+
 def evaluate_rotation_set(
     photos: list[RotationPhoto],
     config: CompassConfig,
@@ -50,43 +125,24 @@ def evaluate_rotation_set(
         ``learned_fraction`` (of the circle covered by training photos), ``errors_deg``
         per crop and the crop details.
     """
-    if len(photos) < 4:
-        raise ValueError(f"need at least 4 photos, got {len(photos)}")
-    train, test = photos[0::2], photos[1::2]
     vc = VisualCompass(config)
-    vc.fit_colors([p.image for p in train])
-    for p in train:
-        vc.learn(p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg))
-    errors, crops = [], []
-    for p in test:
-        w = p.image.shape[1]
-        cw = max(2, int(round(w * crop_width_frac)))
-        for left in np.linspace(0, w - cw, crops_per_photo).round().astype(int):
-            crop, cam = crop_columns(p, int(left), cw)
-            est = vc.estimate(crop, cam)
-            err = abs(float(wrap180(est.heading_deg - p.yaw_deg)))
-            errors.append(err)
-            crops.append(
-                {
-                    "photo": p.name,
-                    "left": int(left),
-                    "width": cw,
-                    "true_yaw_deg": p.yaw_deg,
-                    "estimate_deg": est.heading_deg,
-                    "spread_deg": est.spread_deg,
-                }
-            )
-    e = np.array(errors)
+
+    def prepare(sensor: ImageCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
+        vc.fit_colors([image for image, _ in frames])
+        _learn_all(vc, frames)
+
+    r = rotation_set_errors(photos, vc, prepare, crop_width_frac, crops_per_photo)
+    e = np.array(r["errors_deg"])
     return {
         "median_error_deg": float(np.median(e)),
         "mean_error_deg": float(np.mean(e)),
         "within_5deg": float(np.mean(e < 5.0)),
         "within_10deg": float(np.mean(e < 10.0)),
         "learned_fraction": vc.learned_fraction,
-        "n_train": len(train),
-        "n_crops": len(errors),
+        "n_train": r["n_train"],
+        "n_crops": len(e),
         "errors_deg": [round(float(x), 3) for x in e],
-        "crops": crops,
+        "crops": r["crops"],
     }
 
 

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from vc_gym.angles import interp_circular
-from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas, VisualCompass
+from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas, ImageCompass
 from vc_gym.validation import positive_float
 
 __all__ = [
@@ -70,20 +70,25 @@ def tempered_distribution(log_likelihood: np.ndarray, temperature: float) -> np.
 
 
 class CompassHeadingSensor:
-    """A :class:`VisualCompass` seen by a filter: images in, heading log-likelihoods out.
+    """An image compass seen by a filter: images in, heading log-likelihoods out.
 
     Parameters
     ----------
-    compass : VisualCompass
-        A compass with a learned map.
+    compass : ImageCompass
+        A learned :class:`~vc_gym.compass.VisualCompass`, a baseline compass
+        (:mod:`vc_gym.baselines`) or anything else with the
+        :class:`~vc_gym.compass.ImageCompass` surface.
     camera : Camera
         Intrinsics and pitch of the camera that takes the observations (its yaw is
         ignored). With a turnable head, pass ``head_pan_deg`` to the call instead.
     """
 
-    def __init__(self, compass: VisualCompass, camera: Camera | None = None):
-        if not isinstance(compass, VisualCompass):
-            raise ValueError(f"compass must be a VisualCompass, got {type(compass).__name__}")
+    def __init__(self, compass: ImageCompass, camera: Camera | None = None):
+        if not isinstance(compass, ImageCompass):
+            raise ValueError(
+                "compass must be an image compass (a VisualCompass or a baseline: "
+                f"headings_deg, learn, log_likelihood, estimate), got {type(compass).__name__}"
+            )
         self.compass = compass
         self.camera = Camera() if camera is None else camera
         if not isinstance(self.camera, Camera):
@@ -101,9 +106,8 @@ class CompassHeadingSensor:
         if not math.isfinite(head_pan_deg):
             raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
         ll = self.compass.log_likelihood(observation, self.camera)
-        return interp_circular(
-            ll, self.compass.config.heading_step_deg, np.asarray(headings_deg) + head_pan_deg
-        )
+        step = 360.0 / self.compass.headings_deg.size
+        return interp_circular(ll, step, np.asarray(headings_deg) + head_pan_deg)
 
     def pose_log_likelihood(self, observation: np.ndarray, poses: np.ndarray) -> np.ndarray:
         """Heading-only pose likelihood: depends on the ``θ`` column of ``poses`` alone."""

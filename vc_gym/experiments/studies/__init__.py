@@ -97,6 +97,15 @@ EXPERIMENTS: dict[str, Experiment] = {
             "signatures)",
         ),
         Experiment(
+            "sensors",
+            _P + "sensors",
+            "the baselines of section 6 under one protocol: the visual compass (paper and "
+            "improved), image difference, sector colours, ORB features and a disturbed "
+            "magnetometer learn the same frames; median/p90 heading error at 0, 1, 2 and "
+            "4 m, full and half light, every scene, and on the real photos; ms per frame "
+            "and the accuracy/cost front (sensors.png)",
+        ),
+        Experiment(
             "paper",
             _P + "paper",
             "all of the above at the report's size (< 20 min on 2 cores), writing "

@@ -1,0 +1,88 @@
+"""make_sensor: every sensor by name, dict, import path, callable or instance."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+from vc_gym.baselines import (
+    SENSORS,
+    FeatureCompass,
+    ImageDifferenceCompass,
+    NoisyMagneticCompass,
+    SectorColourCompass,
+    make_sensor,
+    register_sensor,
+)
+from vc_gym.compass import Camera, ImageCompass, VisualCompass
+from vc_gym.filters import HeadingGridFilter
+from vc_gym.localization.sensors import CompassHeadingSensor
+from vc_gym.worlds.panorama import render_view
+
+
+@pytest.mark.parametrize(
+    ("spec", "cls"),
+    [
+        ("visual_compass", VisualCompass),
+        ("image_difference", ImageDifferenceCompass),
+        ("sector_colour", SectorColourCompass),
+        ("feature", FeatureCompass),
+        ("magnetic", NoisyMagneticCompass),
+        ({"type": "magnetic", "noise_deg": 7.0}, NoisyMagneticCompass),
+        (functools.partial(FeatureCompass, n_features=50), FeatureCompass),
+        ("vc_gym.baselines:ImageDifferenceCompass", ImageDifferenceCompass),
+    ],
+)
+def test_specs(spec, cls):
+    assert type(make_sensor(spec)) is cls
+
+
+def test_dict_kwargs_reach_the_constructor():
+    assert make_sensor({"type": "visual_compass", "exposure": "mean"}).config.exposure == "mean"
+    assert make_sensor({"type": "magnetic", "noise_deg": 7.0}).noise_deg == 7.0
+    sensor = NoisyMagneticCompass()
+    assert make_sensor(sensor) is sensor
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ("compass", "unknown sensor 'compass'; known: "),
+        ({"noise_deg": 1.0}, "needs a 'type'"),
+        ({"type": "magnetic", "noise": 1.0}, "bad arguments for sensor 'magnetic'"),
+        (lambda: 42, "gave int"),
+        (3.5, "a sensor spec is"),
+        ("nowhere.module:thing", "cannot import sensor factory"),
+    ],
+)
+def test_bad_specs_say_what_is_wrong(spec, message):
+    with pytest.raises(ValueError, match=message):
+        make_sensor(spec)
+
+
+def test_register_a_users_sensor():
+    register_sensor("my_magnetometer", functools.partial(NoisyMagneticCompass, noise_deg=1.0))
+    try:
+        assert make_sensor("my_magnetometer").noise_deg == 1.0
+        with pytest.raises(ValueError, match="registered already"):
+            register_sensor("my_magnetometer", NoisyMagneticCompass)
+    finally:
+        del SENSORS["my_magnetometer"]
+
+
+@pytest.mark.parametrize("name", ["image_difference", "sector_colour", "feature"])
+def test_every_image_baseline_is_a_filters_heading_sensor(room_pano, name):
+    # the image compass surface: a tracker's heading sensor takes it like the visual compass
+    sensor = make_sensor(name)
+    assert isinstance(sensor, ImageCompass)
+    for yaw in range(0, 360, 15):
+        sensor.learn(render_view(room_pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
+    heading = CompassHeadingSensor(sensor, Camera())
+    f = HeadingGridFilter(rule="bayes")
+    f.reset(0.0, 180.0)
+    for _ in range(3):
+        f.update(heading, render_view(room_pano, Camera(yaw_deg=137.0)))
+    assert abs((f.estimate().heading_deg - 137.0 + 180.0) % 360.0 - 180.0) < 5.0
+    assert np.isfinite(f.estimate().spread_deg)

@@ -1,0 +1,42 @@
+"""Other heading sensors under the visual compass' protocol (the paper's section 6).
+
+Each learns at a spot from frames with a known yaw and answers a log-likelihood over
+headings, like :class:`~vc_gym.compass.VisualCompass` (the
+:class:`~vc_gym.compass.ImageCompass` surface), so the same filters, trackers and
+experiments take them (``vc-gym experiment sensors``):
+
+* :class:`ImageDifferenceCompass` — the rotational image difference (Zeil et al.;
+  Labrosse's visual compass), every shift at once by FFT;
+* :class:`SectorColourCompass` — mean colour per sector (Porta & Kröse);
+* :class:`FeatureCompass` — ORB keypoints learned with their direction;
+* :class:`NoisyMagneticCompass` — a magnetometer: true heading, noise and a local
+  disturbance field (no camera).
+
+>>> from vc_gym.baselines import make_sensor                          # doctest: +SKIP
+>>> sensor = make_sensor("image_difference")                         # doctest: +SKIP
+>>> for image, yaw in frames: sensor.learn(image, Camera(yaw_deg=yaw))  # doctest: +SKIP
+>>> sensor.estimate(new_image, Camera()).heading_deg                 # doctest: +SKIP
+"""
+
+from vc_gym.baselines.base import BaselineCompass, FrameScore
+from vc_gym.baselines.feature import FeatureCompass
+from vc_gym.baselines.image_difference import ImageDifferenceCompass
+from vc_gym.baselines.magnetic import DisturbanceSource, NoisyMagneticCompass
+from vc_gym.baselines.registry import SENSORS, make_sensor, register_sensor
+from vc_gym.baselines.sector_colour import SectorColourCompass
+from vc_gym.baselines.strip import StripGrid, angular_strip
+
+__all__ = [
+    "SENSORS",
+    "BaselineCompass",
+    "DisturbanceSource",
+    "FeatureCompass",
+    "FrameScore",
+    "ImageDifferenceCompass",
+    "NoisyMagneticCompass",
+    "SectorColourCompass",
+    "StripGrid",
+    "angular_strip",
+    "make_sensor",
+    "register_sensor",
+]
