@@ -294,6 +294,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "modes": getattr(args, "modes", None),
         "light": getattr(args, "light", None),
         "data_dir": getattr(args, "data", None),
+        "sensor": getattr(args, "sensor", None),
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -858,6 +859,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="SPEC",
         help="the tracker (homing) or the trackers to compare (trackers; repeat the flag): "
         "grid, particle, kalman, 'package.module:factory' or a JSON object",
+    )
+    p.add_argument(
+        "--sensor",
+        metavar="NAME",
+        help="homing: the grid tracker's heading sensor, learned in a turn at home for "
+        "every learning seed (position still from the atlas): feature, image_difference, "
+        "sector_colour or visual_compass (see `vc-gym experiment sensors`)",
     )
     p.add_argument("--episodes", type=int, help="kidnappings per learning seed (paper: 33)")
     p.add_argument(

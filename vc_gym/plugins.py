@@ -60,8 +60,9 @@ def make_plugin(
     spec : str, dict, callable or instance
         A registered name; ``"package.module:factory"`` (imported, called with no
         arguments: survives pickling and the command line); ``{"type": name,
-        **kwargs}`` (kwargs to the factory); a callable with no arguments; or an
-        instance (``is_instance(spec)``), returned as is.
+        **kwargs}`` (kwargs to the factory; the type may be an import path too); a
+        callable with no arguments; or an instance (``is_instance(spec)``), returned
+        as is.
     registry : mapping
         Names to factories.
     kind : str
@@ -97,7 +98,9 @@ def make_plugin(
         name = kwargs.pop("type", None)
         if not isinstance(name, str):
             raise ValueError(f"a {kind} dict needs a 'type' name, got {spec!r}")
-        factory = known(name)
+        factory = (
+            import_factory(name, kind) if ":" in name and name not in registry else known(name)
+        )
         try:
             obj = factory(**kwargs)
         except TypeError as exc:

@@ -16,7 +16,7 @@ from vc_gym.baselines import (
     make_sensor,
     register_sensor,
 )
-from vc_gym.compass import Camera, ImageCompass, VisualCompass
+from vc_gym.compass import Camera, ImageCompass, MapFileError, VisualCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.localization.sensors import CompassHeadingSensor
 from vc_gym.worlds.panorama import render_view
@@ -86,3 +86,26 @@ def test_every_image_baseline_is_a_filters_heading_sensor(room_pano, name):
         f.update(heading, render_view(room_pano, Camera(yaw_deg=137.0)))
     assert abs((f.estimate().heading_deg - 137.0 + 180.0) % 360.0 - 180.0) < 5.0
     assert np.isfinite(f.estimate().spread_deg)
+
+
+def test_a_saved_sensor_is_a_grid_trackers_heading_sensor(room_pano, tmp_path):
+    from vc_gym.baselines import SENSOR_GRID, load_sensor
+    from vc_gym.localization import GridTracker, make_tracker
+
+    sensor = make_sensor("image_difference")
+    for yaw in range(0, 360, 30):
+        sensor.learn(render_view(room_pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
+    path = sensor.save(tmp_path / "home.npz")
+    loaded = load_sensor("image_difference", path)
+    image = render_view(room_pano, Camera(yaw_deg=77.0))
+    assert np.array_equal(
+        loaded.log_likelihood(image, Camera()), sensor.log_likelihood(image, Camera())
+    )
+    spec = {"type": SENSOR_GRID, "sensor": "image_difference", "sensor_file": str(path)}
+    tracker = make_tracker({**spec, "half_life_s": 0.5})
+    assert isinstance(tracker, GridTracker) and tracker.half_life_s == 0.5
+    assert isinstance(tracker.heading_sensor, ImageDifferenceCompass)
+    with pytest.raises(ValueError, match="not an image sensor that can be saved"):
+        load_sensor("magnetic", path)
+    with pytest.raises(MapFileError, match="home.npz"):
+        load_sensor("feature", path)  # another sensor's file

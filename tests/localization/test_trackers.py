@@ -182,3 +182,29 @@ def test_bad_use_is_a_clear_error(name, room_atlas, frames):
 def test_bad_parameters(cls, kwargs):
     with pytest.raises(ValueError):
         cls(**kwargs)
+
+
+class AlwaysSouth:
+    """An image compass that is sure the camera looks south, whatever it sees."""
+
+    headings_deg = np.arange(360.0)
+
+    def learn(self, image, camera):
+        pass
+
+    def log_likelihood(self, image, camera):
+        return -0.5 * (wrap180(self.headings_deg - 270.0) / 2.0) ** 2
+
+    def estimate(self, image, camera):
+        raise NotImplementedError
+
+
+def test_a_heading_sensor_replaces_the_atlas_heading_but_not_its_position(room_atlas, frames):
+    plain = run(GridTracker(), room_atlas, frames[:9])[-1]
+    south = run(GridTracker(heading_sensor=AlwaysSouth()), room_atlas, frames[:9])[-1]
+    assert abs(wrap180(plain.heading_deg - START[2])) < 10.0
+    assert abs(wrap180(south.heading_deg - 270.0)) < 1.0  # the sensor's word, not the atlas'
+    # standing still, the position comes from the atlas alone: the same either way
+    assert np.allclose(south.position, plain.position)
+    with pytest.raises(ValueError, match="image compass"):
+        GridTracker(heading_sensor="feature")

@@ -12,6 +12,9 @@ experiments take them (``vc-gym experiment sensors``):
 * :class:`NoisyMagneticCompass` — a magnetometer: true heading, noise and a local
   disturbance field (no camera).
 
+The tracker ``{"type": SENSOR_GRID, "sensor": name, "sensor_file": path}`` is the grid
+tracker with a saved image sensor as its heading sensor.
+
 >>> from vc_gym.baselines import make_sensor                          # doctest: +SKIP
 >>> sensor = make_sensor("image_difference")                         # doctest: +SKIP
 >>> for image, yaw in frames: sensor.learn(image, Camera(yaw_deg=yaw))  # doctest: +SKIP
@@ -25,9 +28,17 @@ from vc_gym.baselines.magnetic import DisturbanceSource, NoisyMagneticCompass
 from vc_gym.baselines.registry import SENSORS, make_sensor, register_sensor
 from vc_gym.baselines.sector_colour import SectorColourCompass
 from vc_gym.baselines.strip import StripGrid, angular_strip
+from vc_gym.baselines.tracking import (
+    IMAGE_SENSORS,
+    SENSOR_GRID,
+    load_sensor,
+    sensor_grid_tracker,
+)
 
 __all__ = [
+    "IMAGE_SENSORS",
     "SENSORS",
+    "SENSOR_GRID",
     "BaselineCompass",
     "DisturbanceSource",
     "FeatureCompass",
@@ -37,6 +48,8 @@ __all__ = [
     "SectorColourCompass",
     "StripGrid",
     "angular_strip",
+    "load_sensor",
     "make_sensor",
     "register_sensor",
+    "sensor_grid_tracker",
 ]

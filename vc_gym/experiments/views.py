@@ -58,6 +58,7 @@ __all__ = [
     "distance_table",
     "evaluate_view",
     "field_grid",
+    "learning_turn",
     "look",
     "plot_arrow_field",
     "plot_error_vs_distance",
@@ -316,6 +317,26 @@ def look(
         if terminated:
             raise RobotFell(f"the robot fell while standing at {(x, y, yaw)} (frame {k})")
         out.append(frame(obs))
+    return out
+
+
+def learning_turn(
+    room: AiboRoomEnv, spot: Sequence[float], frames_per_direction: int, seed: int
+) -> list[tuple[np.ndarray, Camera]]:
+    """The frames of a learning turn at ``spot`` with their true camera yaws.
+
+    The robot stands facing 0°, 45°, ..., 315° in turn (paper 4.3), scanning with its
+    head for ``frames_per_direction`` frames each (:func:`look`, seeds ``seed + k``);
+    every frame comes with the camera that took it (its yaw the body's plus the
+    measured pan). The truth, not odometry: every sensor taught with it gets the
+    same, exact headings.
+    """
+    env = getattr(room, "unwrapped", room)
+    camera = Camera(hfov_deg=env.camera.hfov_deg)
+    out = []
+    for k in range(8):
+        for image, pan, _ in look(room, (*spot, 45.0 * k), frames_per_direction, seed=seed + k):
+            out.append((image, camera.replace(yaw_deg=45.0 * k + pan)))
     return out
 
 

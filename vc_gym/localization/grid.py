@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.compass import Camera, CompassAtlas, ImageCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.localization.position import AtlasPositionFilter
 from vc_gym.localization.protocol import (
@@ -13,7 +13,7 @@ from vc_gym.localization.protocol import (
     check_frame_inputs,
     check_reset_inputs,
 )
-from vc_gym.localization.sensors import best_spot_heading_log_likelihood
+from vc_gym.localization.sensors import CompassHeadingSensor, best_spot_heading_log_likelihood
 from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
@@ -49,6 +49,11 @@ class GridTracker:
         Score every spot only every ``rescore_every`` frames and, in between, the
         ``shortlist`` spots that fitted best (:class:`SpotShortlist`). The default
         ``shortlist=None`` (the paper) scores every spot every frame.
+    heading_sensor : ImageCompass, optional
+        Another learned heading sensor (a baseline of :mod:`vc_gym.baselines`, or a
+        visual compass of its own) whose log-likelihood updates the heading filter
+        instead of the atlas' best spot; position still comes from the atlas (eq. 30).
+        Its headings are world headings, like the atlas'.
     """
 
     def __init__(
@@ -60,6 +65,7 @@ class GridTracker:
         rule: str = "mixing",
         shortlist: int | None = None,
         rescore_every: int = 4,
+        heading_sensor: ImageCompass | None = None,
     ):
         self.half_life_s = positive_float("half_life_s", half_life_s)
         self.heading_resolution_deg = positive_float(
@@ -71,6 +77,13 @@ class GridTracker:
         self.spots = SpotShortlist(shortlist, rescore_every)
         # fail now, not at the first reset
         HeadingGridFilter(self.heading_resolution_deg, rule=rule, half_life_s=self.half_life_s)
+        if heading_sensor is not None and not isinstance(heading_sensor, ImageCompass):
+            raise ValueError(
+                "heading_sensor must be an image compass (headings_deg, learn, "
+                f"log_likelihood, estimate), got {type(heading_sensor).__name__}"
+            )
+        self.heading_sensor = heading_sensor
+        self._heading_reader: CompassHeadingSensor | None = None
         self.atlas: CompassAtlas | None = None
 
     def reset(self, atlas: CompassAtlas, camera: Camera, dt_s: float) -> None:
@@ -82,6 +95,8 @@ class GridTracker:
         )
         self.position_filter = AtlasPositionFilter(atlas, self.half_life_s, dt)
         self.spots.reset()
+        if self.heading_sensor is not None:
+            self._heading_reader = CompassHeadingSensor(self.heading_sensor, camera)
 
     def update(
         self, image: np.ndarray, head_pan_deg: float, odometry: np.ndarray | tuple
@@ -93,9 +108,11 @@ class GridTracker:
         hf, pf = self.heading_filter, self.position_filter
         hf.predict(turn, noise_deg=self.motion_noise_deg + self.turn_noise * abs(turn))
         est = self.spots.estimate(self.atlas, image, self.camera)
-        hf.update_log_likelihood(
-            best_spot_heading_log_likelihood(self.atlas, est, hf.headings_deg + pan)
-        )
+        if self._heading_reader is not None:
+            ll = self._heading_reader.heading_log_likelihood(image, hf.headings_deg, pan)
+        else:
+            ll = best_spot_heading_log_likelihood(self.atlas, est, hf.headings_deg + pan)
+        hf.update_log_likelihood(ll)
         heading = hf.estimate()
         pf.predict(fwd, left, heading.heading_deg)
         pf.update(est)

@@ -21,11 +21,14 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.baselines import IMAGE_SENSORS, SENSOR_GRID
 from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.envs.learning import HOME
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.episode import HOMING_MODES, homing_mode, make_homing_run, run_episode
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.runner import Job, worker_cache
+from vc_gym.experiments.spot_sensors import spot_sensor_job
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     open_run,
@@ -54,6 +57,8 @@ MODES = HOMING_MODES
 #: A stop this far from home is a "far stop": the robot trusted a position it had no
 #: evidence for (or never found home).
 FAR_STOP_M = 0.5
+#: Frames per learning direction of a ``--sensor`` at home, by size.
+SENSOR_FRAMES = {"quick": 2, "paper": 8, "full": 8}
 
 SIZES = {
     "quick": {
@@ -225,6 +230,7 @@ def run_homing(
     relearn: str = "scene",
     field: bool = True,
     mode: str = "paper",
+    sensor: str | None = None,
 ) -> dict[str, Any]:
     """Run the homing experiment and write ``results.json``, ``run.json`` and plots.
 
@@ -257,6 +263,12 @@ def run_homing(
     mode : str
         ``"paper"`` or ``"improved"`` (:data:`MODES`: how the place is learned and how
         the scripted agent homes).
+    sensor : str, optional
+        An image sensor of :data:`vc_gym.baselines.IMAGE_SENSORS` (``"feature"``,
+        ``"image_difference"``, ...) as the grid tracker's heading sensor: for every
+        learning seed it learns a turn at home with the true yaws
+        (:data:`SENSOR_FRAMES` frames per direction) and is saved in ``DIR/sensors``;
+        position still comes from the atlas. Needs the grid tracker.
 
     Returns
     -------
@@ -283,6 +295,8 @@ def run_homing(
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
     homing_mode(mode)
     tracker = check_tracker_spec(tracker)
+    if sensor is not None:
+        tracker = _sensor_tracker_options(sensor, tracker, relearn)
     if agent == "pretrained":
         from vc_gym.agents.learned import PRETRAINED_MODEL
 
@@ -309,6 +323,7 @@ def run_homing(
         "relearn": relearn,
         "field": field,
         **({"mode": mode} if mode != "paper" else {}),
+        **({"sensor": sensor, "sensor_frames": SENSOR_FRAMES[opts.size]} if sensor else {}),
     }
     run = open_run(out_dir, "homing", opts, settings)
     specs = {
@@ -318,6 +333,13 @@ def run_homing(
     atlases = (
         ensure_atlases(run, list(specs.values()), opts.atlas_dir) if relearn == "scene" else {}
     )
+    trackers = {s: tracker for s in seeds}
+    if sensor is not None:
+        files = _learn_home_sensors(run, scene, sensor, seeds, SENSOR_FRAMES[opts.size])
+        trackers = {
+            s: {**tracker, "type": SENSOR_GRID, "sensor": sensor, "sensor_file": files[s]}
+            for s in seeds
+        }
     videos = run.out / "videos"
     jobs = []
     for s in seeds:
@@ -325,7 +347,7 @@ def run_homing(
             n = len(jobs)
             kwargs = {
                 "agent": agent,
-                "tracker": tracker,
+                "tracker": trackers[s],
                 "scene": scene,
                 "learn_time_s": learn_time_s,
                 "success_radius_m": success_radius_m,
@@ -370,6 +392,50 @@ def run_homing(
     costs = [c for c in costs if c is not None]
     info = {"tracker_ms_per_update_median": float(np.median(costs)) if costs else None}
     return run.finish(results, info)
+
+
+def _sensor_tracker_options(sensor: str, tracker: Any, relearn: str) -> dict[str, Any]:
+    """The grid tracker options ``tracker`` gives, checked for a ``--sensor`` run."""
+    if sensor not in IMAGE_SENSORS:
+        raise ValueError(
+            f"--sensor {sensor!r}: the homing task's tracker reads camera images; choose "
+            f"one of {list(IMAGE_SENSORS)} (the magnetometer reads the true heading, "
+            "which a tracker is not given)"
+        )
+    kind = tracker if isinstance(tracker, str) else tracker.get("type")
+    if kind != "grid":
+        raise ValueError(f"--sensor needs the grid tracker, got {kind!r}")
+    if relearn != "scene":
+        raise ValueError("--sensor needs relearn='scene' (the sensor is learned once a seed)")
+    return {} if isinstance(tracker, str) else {k: v for k, v in tracker.items() if k != "type"}
+
+
+def _learn_home_sensors(
+    run: Any, scene: str, sensor: str, seeds: Sequence[int], frames: int
+) -> dict[int, str]:
+    """Teach ``sensor`` a turn at home for every learning seed; the saved files."""
+    folder = run.out / "sensors"
+    folder.mkdir(exist_ok=True)
+    jobs = [
+        Job(
+            f"{sensor}-seed{s}",
+            f"{spot_sensor_job.__module__}:spot_sensor_job",
+            {
+                "scene": scene,
+                "sensor": sensor,
+                "spot": list(HOME),
+                "learn_frames": frames,
+                "seed": int(s) * 1000 + 500,
+                "path": str((folder / f"{sensor}-{scene}-seed{s}.npz").resolve()),
+            },
+        )
+        for s in seeds
+    ]
+    outputs = run.run("sensors", jobs)
+    missing = [j.key for j, o in zip(jobs, outputs, strict=True) if o is None]
+    if missing:
+        raise RuntimeError(f"learning the {sensor} sensor failed for {missing} (see results)")
+    return {s: o["path"] for s, o in zip(seeds, outputs, strict=True)}
 
 
 def _likelihood_field(run, opts, size, scene, atlases, spec) -> dict[str, Any]:

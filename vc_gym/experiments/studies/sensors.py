@@ -29,13 +29,12 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from vc_gym.angles import wrap180
 from vc_gym.baselines import NoisyMagneticCompass, make_sensor
-from vc_gym.compass import Camera, VisualCompass
-from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.scenes import SCENES
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.real_data import ROTATION_SETS, default_real_data_dir, load_rotation_set
 from vc_gym.experiments.real_rotation import rotation_set_errors
-from vc_gym.experiments.runner import Job, worker_cache
+from vc_gym.experiments.runner import ExperimentRun, Job
+from vc_gym.experiments.spot_sensors import fit_colours, room, teach
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     median_timings,
@@ -43,10 +42,18 @@ from vc_gym.experiments.studies.common import (
     pick_size,
     scene_field_bounds,
 )
+from vc_gym.experiments.studies.homing import run_homing
 from vc_gym.experiments.studies.orientation import _check_scenes, rear_half_centre
-from vc_gym.experiments.views import look
+from vc_gym.experiments.views import learning_turn, look
 
-__all__ = ["DISTANCES_M", "LIGHTS", "SENSORS", "cost_lines", "run_sensors", "summary_lines"]
+__all__ = [
+    "DISTANCES_M",
+    "LIGHTS",
+    "SENSORS",
+    "cost_lines",
+    "run_sensors",
+    "summary_lines",
+]
 
 #: Sensors compared, by the name the results use: a sensor spec
 #: (:func:`vc_gym.baselines.make_sensor`).
@@ -67,10 +74,25 @@ VIEW_MARGIN_M = 0.3
 #: The magnetometer's field: sources of disturbance per scene, their peak deviation and
 #: radius (steel furniture), and its white noise.
 MAGNETIC_FIELD = {"n_sources": 4, "deviation_deg": 25.0, "radius_m": 0.6, "noise_deg": 3.0}
+#: Trackers of the homing part: ``atlas`` is the paper's grid tracker on the learned
+#: atlas; every other name is an image sensor as its heading sensor
+#: (``vc-gym experiment homing --sensor NAME``). The magnetometer reads no image, so
+#: it cannot be a tracker's sensor.
+HOMING_SENSORS = ("atlas", "visual_compass", "image_difference", "sector_colour", "feature")
+#: What the sensor experiment reports of each homing run.
+HOMING_FIGURES = (
+    "episodes",
+    "success_rate",
+    "mean_stop_distance_cm",
+    "median_stop_distance_cm",
+    "far_stops",
+    "timed_out",
+    "mean_heading_error_deg",
+)
 SIZES = {
-    "quick": {"learn_frames": 2, "views": 2},
-    "paper": {"learn_frames": 8, "views": 8},
-    "full": {"learn_frames": 8, "views": 20},
+    "quick": {"learn_frames": 2, "views": 2, "homing_episodes": 0},
+    "paper": {"learn_frames": 8, "views": 8, "homing_episodes": 11},
+    "full": {"learn_frames": 8, "views": 20, "homing_episodes": 33},
 }
 
 
@@ -97,20 +119,6 @@ def view_poses_at(
     return poses
 
 
-def _fit_colours(sensor: Any, frames: Sequence[tuple[np.ndarray, Camera]]) -> None:
-    """A visual compass first fits its colour classes on one frame per learning
-    direction (as the robot does); other sensors need nothing."""
-    if isinstance(sensor, VisualCompass) and sensor.colors is None:
-        sensor.fit_colors([img for img, _ in frames[:: max(1, len(frames) // 8)]])
-
-
-def _learn(sensor: Any, frames: Sequence[tuple[np.ndarray, Camera]]) -> None:
-    """Teach ``sensor`` the frames (colour classes first, if it has any)."""
-    _fit_colours(sensor, frames)
-    for image, camera in frames:
-        sensor.learn(image, camera)
-
-
 def _magnetometer(scene: str, bounds: Sequence[float], seed: int) -> NoisyMagneticCompass:
     rng = np.random.default_rng([seed, 97, SCENES.index(scene) if scene in SCENES else 99])
     return NoisyMagneticCompass.random_field(bounds, rng, **MAGNETIC_FIELD)
@@ -131,25 +139,18 @@ def sensors_scene_job(
     "spreads": {sensor: spread}}], "timing": {"<sensor>/learn": ms per frame,
     "<sensor>/localise": ms per frame}}``.
     """
-    rooms = {
-        light: worker_cache(("room", scene, light), lambda light=light: _room(scene, light))
-        for light in sorted({v["light"] for v in views} | {1.0})
-    }
-    room = rooms[1.0]
-    camera = Camera(hfov_deg=room.camera.hfov_deg)
-    learning = []
-    for k in range(8):
-        for image, pan, _ in look(room, (*spot, 45.0 * k), learn_frames, seed=seed + k):
-            learning.append((image, camera.replace(yaw_deg=45.0 * k + pan)))
+    rooms = {light: room(scene, light) for light in sorted({v["light"] for v in views} | {1.0})}
+    learning = learning_turn(rooms[1.0], spot, learn_frames, seed)
+    camera = learning[0][1].replace(yaw_deg=0.0)
     built, timing = {}, {}
     for name, spec in sensors.items():
         if spec == "magnetic" or (isinstance(spec, Mapping) and spec.get("type") == "magnetic"):
             built[name] = _magnetometer(scene, bounds, seed)
             continue
         sensor = make_sensor(spec)
-        _fit_colours(sensor, learning)  # once per place: not part of the per-frame cost
+        fit_colours(sensor, learning)  # once per place: not part of the per-frame cost
         t0 = time.perf_counter()
-        _learn(sensor, learning)
+        teach(sensor, learning)
         timing[f"{name}/learn"] = 1e3 * (time.perf_counter() - t0) / len(learning)
         built[name] = sensor
     out, cost = [], {name: [] for name in built}
@@ -174,10 +175,6 @@ def sensors_scene_job(
     return {"views": out, "timing": timing}
 
 
-def _room(scene: str, light: float) -> AiboRoomEnv:
-    return AiboRoomEnv(scene=scene, illumination=light)
-
-
 def sensors_real_job(folder: str, sensors: dict[str, Any]) -> dict[str, Any]:
     """Job: the real-photo crop protocol for every image sensor on one rotation set."""
     photos = load_rotation_set(folder)
@@ -185,7 +182,7 @@ def sensors_real_job(folder: str, sensors: dict[str, Any]) -> dict[str, Any]:
     for name, spec in sensors.items():
         if spec == "magnetic" or (isinstance(spec, Mapping) and spec.get("type") == "magnetic"):
             continue
-        r = rotation_set_errors(photos, make_sensor(spec), prepare=_learn)
+        r = rotation_set_errors(photos, make_sensor(spec), prepare=teach)
         e = np.asarray(r["errors_deg"])
         out[name] = _error_stats(e)
         timing[f"{name}/learn"] = r["learn_ms"]
@@ -281,9 +278,36 @@ def run_sensors(
     else:
         results["real"] = None
         results["real_skipped"] = "no ../shared/data/real folder (give --data DIR)"
+    if size["homing_episodes"]:
+        results["homing"] = _homing(run, opts, size["homing_episodes"])
     cost = _cost_info(run)
     _plot(run.out / "sensors.png", results, cost)
     return run.finish(results, cost)
+
+
+def _homing(run: ExperimentRun, opts: ExperimentOptions, episodes: int) -> dict[str, Any]:
+    """The homing experiment (robolab, learning seed ``opts.seed``) with every tracker of
+    :data:`HOMING_SENSORS`, each a run of its own in ``DIR/homing/<name>`` on the same
+    atlas and kidnappings."""
+    out: dict[str, Any] = {}
+    atlas_dir = opts.atlas_dir
+    for name in HOMING_SENSORS:
+        sub = ExperimentOptions(
+            seed=opts.seed,
+            size=opts.size,
+            backend=run.backend,
+            atlas_dir=atlas_dir,
+            progress=opts.progress,
+        )
+        folder = run.out / "homing" / name
+        r = run_homing(
+            folder, sub, episodes=episodes, field=False, sensor=None if name == "atlas" else name
+        )
+        if atlas_dir is None and (folder / "atlases").is_dir():
+            atlas_dir = folder / "atlases"  # every sensor homes on the same atlas
+        overall = r.get("overall", {})
+        out[name] = {k: overall.get(k) for k in HOMING_FIGURES}
+    return out
 
 
 def _summarise_views(outputs: Sequence[Mapping[str, Any]], scenes: Sequence[str]) -> dict:
@@ -340,8 +364,10 @@ def _plot(path: Path, results: Mapping[str, Any], cost: Mapping[str, Any]) -> No
     """Left: median |error| vs distance (full light solid, half dashed) per sensor;
     right: median |error| within 2 m against localise ms per frame, with the front."""
     sensors = results["simulated"]["sensors"]
-    fig = new_figure(figsize=(11, 4.3), layout="constrained")
-    ax, ax2 = fig.subplots(1, 2)
+    homing = results.get("homing")
+    fig = new_figure(figsize=(16 if homing else 11, 4.3), layout="constrained")
+    axes = fig.subplots(1, 3 if homing else 2)
+    ax, ax2 = axes[0], axes[1]
     colors = {n: f"C{i}" for i, n in enumerate(sensors)}
     for name, per in sensors.items():
         for light, style in ((1.0, "o-"), (0.5, "s--")):
@@ -408,7 +434,34 @@ def _plot(path: Path, results: Mapping[str, Any], cost: Mapping[str, Any]) -> No
     ax2.set_ylabel("median |heading error| within 2 m (°)")
     ax2.set_title("accuracy against cost (lower left is better)", fontsize=10)
     ax2.grid(alpha=0.3, which="both")
+    if homing:
+        _plot_homing(axes[2], homing, colors)
     save_figure(fig, path)
+
+
+def _plot_homing(ax: Any, homing: Mapping[str, Any], colors: Mapping[str, str]) -> None:
+    """Homing success per tracker heading sensor, with stop distance and heading error."""
+    names = list(homing)
+    success = [100.0 * (homing[n]["success_rate"] or 0.0) for n in names]
+    ax.bar(range(len(names)), success, color=[colors.get(n, "0.5") for n in names])
+    for i, n in enumerate(names):
+        h = homing[n]
+        ax.annotate(
+            f"{h['mean_stop_distance_cm']} cm\n{h['mean_heading_error_deg']}°",
+            (i, success[i]),
+            ha="center",
+            va="bottom",
+            fontsize=7,
+        )
+    ax.set_xticks(range(len(names)), names, rotation=25, ha="right", fontsize=8)
+    ax.set_ylim(0, 115)
+    ax.set_ylabel("homing success within 30 cm (%)")
+    episodes = homing[names[0]]["episodes"] if names else 0
+    ax.set_title(
+        f"homing with each heading sensor ({episodes} kidnappings;\n"
+        "labels: mean stop distance, mean heading error)",
+        fontsize=10,
+    )
 
 
 def _front(points: Sequence[tuple[float, float, str]]) -> list[tuple[float, float, str]]:
@@ -443,6 +496,12 @@ def summary_lines(results: Mapping[str, Any]) -> list[str]:
             + ", ".join(parts)
             + (f"; half light medians {half}" if half else "")
             + (f"; real {', '.join(r)}" if r else "")
+        )
+    for name, h in (results.get("homing") or {}).items():
+        lines.append(
+            f"homing with {name:18s}: success {h['success_rate']:.0%}, mean stop distance "
+            f"{h['mean_stop_distance_cm']} cm, {h['far_stops']} stops > 50 cm, mean heading "
+            f"error {h['mean_heading_error_deg']}° ({h['episodes']} kidnappings)"
         )
     if results.get("real_skipped"):
         lines.append(f"real photos skipped: {results['real_skipped']}")
