@@ -26,7 +26,7 @@ from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
 
-__all__ = ["BaselineCompass", "FrameScore", "check_camera"]
+__all__ = ["BaselineCompass", "FrameScore", "check_camera", "estimate_of", "heading_grid"]
 
 
 def check_camera(camera: object) -> Camera:
@@ -34,6 +34,30 @@ def check_camera(camera: object) -> Camera:
     if not isinstance(camera, Camera):
         raise ValueError(f"camera must be a vc_gym.compass.Camera, got {type(camera).__name__}")
     return camera
+
+
+def heading_grid(step_deg: float) -> np.ndarray:
+    """The read-only heading grid ``0, step, ..., 360 - step`` (``step`` must divide 360
+    and be at most 90°)."""
+    step = positive_float("heading_step_deg", step_deg)
+    n = 360.0 / step
+    if step > 90.0 or abs(n - round(n)) > 1e-9:
+        raise ValueError(f"heading_step_deg must divide 360 (and be <= 90), got {step}")
+    h = np.arange(int(round(n)), dtype=np.float64) * step
+    h.setflags(write=False)
+    return h
+
+
+def estimate_of(
+    log_likelihood: np.ndarray, headings_deg: np.ndarray, goodness: float, n_terms: int
+) -> CompassEstimate:
+    """A :class:`~vc_gym.compass.CompassEstimate` from a log-likelihood on the grid
+    ``headings_deg``: the parabola-refined arg-max and the circular spread of the
+    posterior ``∝ exp(log-likelihood)`` (eq. 25-27)."""
+    ll = np.asarray(log_likelihood, dtype=np.float64)[None]
+    heading, best = peak_headings(ll, 360.0 / headings_deg.size)
+    spread = circular_std_rows(headings_deg, np.exp(ll - ll[0, best[0]]))
+    return CompassEstimate(float(heading[0]), float(spread[0]), goodness, n_terms, ll[0])
 
 
 class FrameScore:
@@ -73,14 +97,8 @@ class BaselineCompass(ABC):
     name: ClassVar[str] = ""
 
     def __init__(self, heading_step_deg: float = 1.0):
-        step = positive_float("heading_step_deg", heading_step_deg)
-        n = 360.0 / step
-        if step > 90.0 or abs(n - round(n)) > 1e-9:
-            raise ValueError(f"heading_step_deg must divide 360 (and be <= 90), got {step}")
-        self.heading_step_deg = step
-        h = np.arange(int(round(n)), dtype=np.float64) * step
-        h.setflags(write=False)
-        self._headings = h
+        self._headings = heading_grid(heading_step_deg)
+        self.heading_step_deg = float(heading_step_deg)
         self._frames = 0
 
     # ------------------------------------------------------------------ properties
@@ -155,12 +173,7 @@ class BaselineCompass(ABC):
         ``n_sectors`` the number of terms the frame contributed.
         """
         s = self._checked_score(image, camera)
-        ll = s.log_likelihood[None]
-        heading, best = peak_headings(ll, self.heading_step_deg)
-        spread = circular_std_rows(self._headings, np.exp(ll - ll[0, best[0]]))
-        return CompassEstimate(
-            float(heading[0]), float(spread[0]), s.goodness, s.n_terms, s.log_likelihood
-        )
+        return estimate_of(s.log_likelihood, self._headings, s.goodness, s.n_terms)
 
     def heading_log_likelihood(
         self,

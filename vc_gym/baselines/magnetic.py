@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vc_gym.angles import circular_std_rows, peak_headings, wrap180, wrap360
+from vc_gym.angles import wrap180, wrap360
+from vc_gym.baselines.base import estimate_of, heading_grid
 from vc_gym.compass import CompassEstimate
 from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
 
@@ -94,14 +95,8 @@ class NoisyMagneticCompass:
         self.sources = srcs
         sigma = max(self.noise_deg, 1.0) if model_noise_deg is None else model_noise_deg
         self.model_noise_deg = positive_float("model_noise_deg", sigma)
-        step = positive_float("heading_step_deg", heading_step_deg)
-        n = 360.0 / step
-        if step > 90.0 or abs(n - round(n)) > 1e-9:
-            raise ValueError(f"heading_step_deg must divide 360 (and be <= 90), got {step}")
-        self.heading_step_deg = step
-        h = np.arange(int(round(n)), dtype=np.float64) * step
-        h.setflags(write=False)
-        self._headings = h
+        self._headings = heading_grid(heading_step_deg)
+        self.heading_step_deg = float(heading_step_deg)
 
     @classmethod
     def random_field(
@@ -189,10 +184,7 @@ class NoisyMagneticCompass:
 
         ``n_sectors`` is 1 (one reading).
         """
-        ll = self.log_likelihood(reading)[None]
-        heading, best = peak_headings(ll, self.heading_step_deg)
-        spread = circular_std_rows(self._headings, np.exp(ll - ll[0, best[0]]))
-        return CompassEstimate(float(heading[0]), float(spread[0]), 0.0, 1, ll[0])
+        return estimate_of(self.log_likelihood(reading), self._headings, 0.0, 1)
 
     def __repr__(self) -> str:
         return (

@@ -332,6 +332,7 @@ def train(
     """
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.logger import Logger
     from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
@@ -414,6 +415,9 @@ def train(
             if config.demo_episodes:
                 warm_start = _warm_start(model, venv, config, progress)
                 write_json(out / "warm_start.json", warm_start)
+        if tb is None:
+            # without it SB3 makes an empty /tmp/SB3-<date> folder at every learn()
+            model.set_logger(Logger(folder=None, output_formats=[]))
         with warnings.catch_warnings():
             # evaluation runs in this process (DummyVecEnv) on purpose
             warnings.filterwarnings("ignore", "Training and eval env are not of the same type")
