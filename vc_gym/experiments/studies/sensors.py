@@ -182,7 +182,7 @@ def sensors_real_job(folder: str, sensors: dict[str, Any]) -> dict[str, Any]:
     for name, spec in sensors.items():
         if spec == "magnetic" or (isinstance(spec, Mapping) and spec.get("type") == "magnetic"):
             continue
-        r = rotation_set_errors(photos, make_sensor(spec), prepare=teach)
+        r = rotation_set_errors(photos, make_sensor(spec), prepare=teach, setup=fit_colours)
         e = np.asarray(r["errors_deg"])
         out[name] = _error_stats(e)
         timing[f"{name}/learn"] = r["learn_ms"]
