@@ -399,8 +399,7 @@ def _plot(path: Path, results: Mapping[str, Any], cost: Mapping[str, Any]) -> No
             continue
         err = full["median_abs_error_deg"]
         pts.append((loc, err, name))
-        ax2.scatter([loc], [err], color=colors[name], s=45, zorder=3)
-        ax2.annotate(name, (loc, err), fontsize=7, xytext=(4, 3), textcoords="offset points")
+        ax2.scatter([loc], [err], color=colors[name], s=45, zorder=3, label=name)
         if half is not None:
             ax2.scatter(
                 [loc],
@@ -421,8 +420,7 @@ def _plot(path: Path, results: Mapping[str, Any], cost: Mapping[str, Any]) -> No
             ls=":",
             label="front (full light)",
         )
-    ax2.scatter([], [], color="0.4", label="full light")
-    ax2.scatter([], [], facecolors="none", edgecolors="0.4", label="half light")
+    ax2.scatter([], [], facecolors="none", edgecolors="0.4", label="(hollow: half light)")
     ax2.legend(fontsize=7)
     ax2.set_xscale("log")
     ax2.set_yscale("log")
