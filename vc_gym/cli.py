@@ -865,7 +865,8 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME",
         help="homing: the grid tracker's heading sensor, learned in a turn at home for "
         "every learning seed (position still from the atlas): feature, image_difference, "
-        "sector_colour or visual_compass (see `vc-gym experiment sensors`)",
+        "sector_colour, visual_compass, or magnetic (a magnetometer in the head; see "
+        "`vc-gym experiment sensors`)",
     )
     p.add_argument("--episodes", type=int, help="kidnappings per learning seed (paper: 33)")
     p.add_argument(

@@ -24,7 +24,7 @@ tracker with a saved image sensor as its heading sensor.
 from vc_gym.baselines.base import BaselineCompass, FrameScore
 from vc_gym.baselines.feature import FeatureCompass
 from vc_gym.baselines.image_difference import ImageDifferenceCompass
-from vc_gym.baselines.magnetic import DisturbanceSource, NoisyMagneticCompass
+from vc_gym.baselines.magnetic import DisturbanceSource, MagnetometerCompass, NoisyMagneticCompass
 from vc_gym.baselines.registry import SENSORS, make_sensor, register_sensor
 from vc_gym.baselines.sector_colour import SectorColourCompass
 from vc_gym.baselines.strip import StripGrid, angular_strip
@@ -44,6 +44,7 @@ __all__ = [
     "FeatureCompass",
     "FrameScore",
     "ImageDifferenceCompass",
+    "MagnetometerCompass",
     "NoisyMagneticCompass",
     "SectorColourCompass",
     "StripGrid",

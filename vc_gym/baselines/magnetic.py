@@ -12,17 +12,17 @@ wrong.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from vc_gym.angles import wrap180, wrap360
 from vc_gym.baselines.base import estimate_of, heading_grid
-from vc_gym.compass import CompassEstimate
+from vc_gym.compass import Camera, CompassEstimate
 from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
 
-__all__ = ["DisturbanceSource", "NoisyMagneticCompass"]
+__all__ = ["DisturbanceSource", "MagnetometerCompass", "NoisyMagneticCompass"]
 
 
 @dataclass(frozen=True)
@@ -191,3 +191,58 @@ class NoisyMagneticCompass:
             f"NoisyMagneticCompass(noise_deg={self.noise_deg}, {len(self.sources)} sources, "
             f"model_noise_deg={self.model_noise_deg})"
         )
+
+
+class MagnetometerCompass:
+    """A magnetometer in the robot's head, offered as an image compass (simulation only).
+
+    A tracker reads its heading sensor with each camera frame; this one ignores the frame
+    and reads ``magnetometer`` at the head's true pose, which ``head_pose()`` returns
+    (``(x, y, head yaw in degrees)`` from the simulator). So the grid tracker homes with
+    a magnetometer where it would use a compass (``vc-gym experiment homing --sensor
+    magnetic``). Nothing is learned.
+
+    Parameters
+    ----------
+    magnetometer : NoisyMagneticCompass
+        Noise and disturbance field.
+    head_pose : callable
+        ``head_pose() -> (x_m, y_m, yaw_deg)``: where the head is and looks now.
+    rng : numpy.random.Generator
+        The noise draws.
+    """
+
+    def __init__(
+        self,
+        magnetometer: NoisyMagneticCompass,
+        head_pose: Callable[[], Sequence[float]],
+        rng: np.random.Generator,
+    ):
+        if not isinstance(magnetometer, NoisyMagneticCompass):
+            raise ValueError(
+                f"magnetometer must be a NoisyMagneticCompass, got {type(magnetometer).__name__}"
+            )
+        if not callable(head_pose):
+            raise ValueError("head_pose must be a callable returning (x, y, yaw_deg)")
+        if not isinstance(rng, np.random.Generator):
+            raise ValueError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
+        self.magnetometer, self.head_pose, self.rng = magnetometer, head_pose, rng
+
+    @property
+    def headings_deg(self) -> np.ndarray:
+        """The magnetometer's heading grid."""
+        return self.magnetometer.headings_deg
+
+    def learn(self, image: np.ndarray, camera: Camera) -> None:
+        """Nothing to learn: a magnetometer knows north."""
+
+    def _reading(self) -> float:
+        return self.magnetometer.read(tuple(self.head_pose()), self.rng)
+
+    def log_likelihood(self, image: np.ndarray, camera: Camera) -> np.ndarray:
+        """The log-likelihood of one reading taken now (the image is not looked at)."""
+        return self.magnetometer.log_likelihood(self._reading())
+
+    def estimate(self, image: np.ndarray, camera: Camera) -> CompassEstimate:
+        """The estimate of one reading taken now (the image is not looked at)."""
+        return self.magnetometer.estimate(self._reading())

@@ -21,7 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.baselines import IMAGE_SENSORS, SENSOR_GRID
+from vc_gym.baselines import (
+    IMAGE_SENSORS,
+    SENSOR_GRID,
+    MagnetometerCompass,
+    NoisyMagneticCompass,
+)
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.envs.learning import HOME
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
@@ -59,6 +64,8 @@ MODES = HOMING_MODES
 FAR_STOP_M = 0.5
 #: Frames per learning direction of a ``--sensor`` at home, by size.
 SENSOR_FRAMES = {"quick": 2, "paper": 8, "full": 8}
+#: ``--sensor`` name of the magnetometer (it reads the true heading, not images).
+MAGNETIC = "magnetic"
 
 SIZES = {
     "quick": {
@@ -130,18 +137,24 @@ def episode_job(
     episode_seed: int,
     video: str | None = None,
     mode: str = "paper",
+    magnetometer: bool = False,
 ) -> dict[str, Any]:
     """Job: one kidnapping (seed ``episode_seed``) with the saved ``atlas``.
 
     ``atlas=None`` learns anew in the episode (``relearn="episode"``). With ``video``
     the episode is also written there as MP4. ``mode`` is the homing mode (its policy;
-    a saved atlas brings its own learning). Returns the episode's figures.
+    a saved atlas brings its own learning). With ``magnetometer`` the grid tracker's
+    heading sensor is a magnetometer in the robot's head (the disturbance field of
+    :meth:`NoisyMagneticCompass.random_field` seeded by the learning seed, its noise by
+    the episode's). Returns the episode's figures.
     """
     kwargs = dict(locals())
     cache_key = json.dumps(
         {k: v for k, v in kwargs.items() if k not in ("episode_seed",)}, sort_keys=True
     )
     run = worker_cache(("homing-run", cache_key), lambda: _run_for(kwargs))
+    if magnetometer:
+        _fit_magnetometer(run, learning_seed, episode_seed)
     if video is not None:
         from vc_gym.experiments.video import write_episode_video
 
@@ -153,6 +166,24 @@ def episode_job(
     ms = 1e3 * record.tracker_time_s / record.tracker_updates if record.tracker_updates else None
     out["timing"] = {"tracker_ms_per_update": ms}
     return out
+
+
+def _fit_magnetometer(run: Any, learning_seed: int, episode_seed: int) -> None:
+    """Make a magnetometer in the robot's head the grid tracker's heading sensor."""
+    room = run.env.unwrapped.room
+    field = NoisyMagneticCompass.random_field(
+        room.scene.field_bounds, np.random.default_rng([learning_seed, 97])
+    )
+    robot = room.robot
+
+    def head_pose() -> tuple[float, float, float]:
+        x, y, yaw = robot.pose
+        return x, y, yaw + float(robot.head[0])
+
+    tracker = run.env.get_wrapper_attr("tracker")
+    tracker.heading_sensor = MagnetometerCompass(
+        field, head_pose, np.random.default_rng([episode_seed, 98])
+    )
 
 
 def field_job(
@@ -268,7 +299,9 @@ def run_homing(
         ``"image_difference"``, ...) as the grid tracker's heading sensor: for every
         learning seed it learns a turn at home with the true yaws
         (:data:`SENSOR_FRAMES` frames per direction) and is saved in ``DIR/sensors``;
-        position still comes from the atlas. Needs the grid tracker.
+        position still comes from the atlas. ``"magnetic"``: a magnetometer in the
+        robot's head (:class:`~vc_gym.baselines.MagnetometerCompass`, nothing learned).
+        Needs the grid tracker.
 
     Returns
     -------
@@ -296,7 +329,7 @@ def run_homing(
     homing_mode(mode)
     tracker = check_tracker_spec(tracker)
     if sensor is not None:
-        tracker = _sensor_tracker_options(sensor, tracker, relearn)
+        grid_options = _sensor_tracker_options(sensor, tracker, relearn)
     if agent == "pretrained":
         from vc_gym.agents.learned import PRETRAINED_MODEL
 
@@ -323,7 +356,12 @@ def run_homing(
         "relearn": relearn,
         "field": field,
         **({"mode": mode} if mode != "paper" else {}),
-        **({"sensor": sensor, "sensor_frames": SENSOR_FRAMES[opts.size]} if sensor else {}),
+        **({"sensor": sensor} if sensor else {}),
+        **(
+            {"sensor_frames": SENSOR_FRAMES[opts.size]}
+            if sensor is not None and sensor != MAGNETIC
+            else {}
+        ),
     }
     run = open_run(out_dir, "homing", opts, settings)
     specs = {
@@ -334,10 +372,10 @@ def run_homing(
         ensure_atlases(run, list(specs.values()), opts.atlas_dir) if relearn == "scene" else {}
     )
     trackers = {s: tracker for s in seeds}
-    if sensor is not None:
+    if sensor is not None and sensor != MAGNETIC:
         files = _learn_home_sensors(run, scene, sensor, seeds, SENSOR_FRAMES[opts.size])
         trackers = {
-            s: {**tracker, "type": SENSOR_GRID, "sensor": sensor, "sensor_file": files[s]}
+            s: {**grid_options, "type": SENSOR_GRID, "sensor": sensor, "sensor_file": files[s]}
             for s in seeds
         }
     videos = run.out / "videos"
@@ -356,6 +394,7 @@ def run_homing(
                 "learning_seed": s,
                 "episode_seed": s + 1 + i,
                 **({"mode": mode} if mode != "paper" else {}),
+                **({"magnetometer": True} if sensor == MAGNETIC else {}),
             }
             if n < opts.video:
                 kwargs["video"] = str((videos / f"seed{s}-episode{i:03d}.mp4").resolve())
@@ -396,12 +435,8 @@ def run_homing(
 
 def _sensor_tracker_options(sensor: str, tracker: Any, relearn: str) -> dict[str, Any]:
     """The grid tracker options ``tracker`` gives, checked for a ``--sensor`` run."""
-    if sensor not in IMAGE_SENSORS:
-        raise ValueError(
-            f"--sensor {sensor!r}: the homing task's tracker reads camera images; choose "
-            f"one of {list(IMAGE_SENSORS)} (the magnetometer reads the true heading, "
-            "which a tracker is not given)"
-        )
+    if sensor not in (*IMAGE_SENSORS, MAGNETIC):
+        raise ValueError(f"--sensor {sensor!r}: choose one of {[*IMAGE_SENSORS, MAGNETIC]}")
     kind = tracker if isinstance(tracker, str) else tracker.get("type")
     if kind != "grid":
         raise ValueError(f"--sensor needs the grid tracker, got {kind!r}")

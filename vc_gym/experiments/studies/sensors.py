@@ -76,9 +76,15 @@ VIEW_MARGIN_M = 0.3
 MAGNETIC_FIELD = {"n_sources": 4, "deviation_deg": 25.0, "radius_m": 0.6, "noise_deg": 3.0}
 #: Trackers of the homing part: ``atlas`` is the paper's grid tracker on the learned
 #: atlas; every other name is an image sensor as its heading sensor
-#: (``vc-gym experiment homing --sensor NAME``). The magnetometer reads no image, so
-#: it cannot be a tracker's sensor.
-HOMING_SENSORS = ("atlas", "visual_compass", "image_difference", "sector_colour", "feature")
+#: (``vc-gym experiment homing --sensor NAME``); the magnetometer sits in the head.
+HOMING_SENSORS = (
+    "atlas",
+    "visual_compass",
+    "image_difference",
+    "sector_colour",
+    "feature",
+    "magnetic",
+)
 #: What the sensor experiment reports of each homing run.
 HOMING_FIGURES = (
     "episodes",
