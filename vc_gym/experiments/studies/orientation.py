@@ -61,6 +61,7 @@ from vc_gym.experiments.views import (
 from vc_gym.validation import positive_float
 
 __all__ = [
+    "check_scenes",
     "DEFAULT_TRACKERS",
     "MODE_TRACKER_OPTIONS",
     "VIEW_MODES",
@@ -475,7 +476,7 @@ def _run_views(name, out_dir, opts, trackers, scenes, modes=None, light=1.0) -> 
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
     named = check_trackers(trackers or DEFAULT_TRACKERS)
-    scenes = _check_scenes(scenes)
+    scenes = check_scenes(scenes)
     modes = _check_modes(modes)
     light = positive_float("light", light)
     if light > 1.0:
@@ -539,7 +540,7 @@ def _plot_scenes(path: Path, per_scene: Mapping[str, Any], tracker: str = "grid"
     save_figure(fig, path)
 
 
-def _check_scenes(scenes: Sequence[str]) -> list[str]:
+def check_scenes(scenes: Sequence[str]) -> list[str]:
     from vc_gym.envs.scenes import check_scene_name
 
     out = [check_scene_name(s) for s in scenes]

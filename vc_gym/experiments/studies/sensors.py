@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import zlib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -29,7 +30,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from vc_gym.angles import wrap180
 from vc_gym.baselines import NoisyMagneticCompass, make_sensor
-from vc_gym.envs.scenes import SCENES
+from vc_gym.envs.scenes import scene_names
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.real_data import ROTATION_SETS, default_real_data_dir, load_rotation_set
 from vc_gym.experiments.real_rotation import rotation_set_errors
@@ -43,7 +44,7 @@ from vc_gym.experiments.studies.common import (
     scene_field_bounds,
 )
 from vc_gym.experiments.studies.homing import run_homing
-from vc_gym.experiments.studies.orientation import _check_scenes, rear_half_centre
+from vc_gym.experiments.studies.orientation import check_scenes, rear_half_centre
 from vc_gym.experiments.views import learning_turn, look
 
 __all__ = [
@@ -126,7 +127,7 @@ def view_poses_at(
 
 
 def _magnetometer(scene: str, bounds: Sequence[float], seed: int) -> NoisyMagneticCompass:
-    rng = np.random.default_rng([seed, 97, SCENES.index(scene) if scene in SCENES else 99])
+    rng = np.random.default_rng([seed, 97, zlib.crc32(scene.encode())])
     return NoisyMagneticCompass.random_field(bounds, rng, **MAGNETIC_FIELD)
 
 
@@ -220,7 +221,7 @@ def run_sensors(
     opts : ExperimentOptions
         Seed (view poses, head scans, the magnetometer's field) and size.
     scenes : sequence of str, optional
-        Registered scenes (default: all of them).
+        Registered scenes (default: every registered scene).
     data_dir : path-like, optional
         Folder of the real rotation sets (default ``../shared/data/real`` when it
         exists; without it the real part is skipped and the results say so).
@@ -233,7 +234,7 @@ def run_sensors(
     """
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
-    scenes = _check_scenes(list(scenes) if scenes else list(SCENES))
+    scenes = check_scenes(list(scenes) if scenes else list(scene_names()))
     real = Path(data_dir) if data_dir is not None else default_real_data_dir()
     if real is not None and not all((real / s).is_dir() for s in ROTATION_SETS):
         raise ValueError(f"--data {real}: expected the folders {sorted(ROTATION_SETS)}")
@@ -250,7 +251,7 @@ def run_sensors(
     for s_i, scene in enumerate(scenes):
         bounds = scene_field_bounds(scene)
         spot = rear_half_centre(bounds)
-        rng = np.random.default_rng([opts.seed, 61, SCENES.index(scene)])
+        rng = np.random.default_rng([opts.seed, 61, zlib.crc32(scene.encode())])
         views = [
             {"distance_m": d, "light": light, "pose": pose}
             for d in DISTANCES_M
