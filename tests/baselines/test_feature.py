@@ -13,7 +13,7 @@ from vc_gym.baselines.feature import FeatureCompass, _thin_by_azimuth, keypoint_
 from vc_gym.compass import Camera
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.experiments.real_data import load_rotation_set
-from vc_gym.experiments.real_rotation import crop_columns
+from vc_gym.experiments.real_rotation import rotation_set_errors
 from vc_gym.persistence import save_npz_atomic
 from vc_gym.worlds.panorama import render_view
 
@@ -166,20 +166,8 @@ def test_matcher_equals_bfmatcher_knn(room_pano, room_fc):
 
 # ---------------------------------------------------------------- real photos
 def _real_errors(real_data_dir, name):
-    photos = load_rotation_set(real_data_dir / name)
-    fc = FeatureCompass()
-    for p in photos[0::2]:
-        fc.learn(p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg))
-    errs, spreads = [], []
-    for p in photos[1::2]:
-        w = p.image.shape[1]
-        cw = w // 2
-        for left in np.linspace(0, w - cw, 3).round().astype(int):
-            crop, cam = crop_columns(p, int(left), cw)
-            est = fc.estimate(crop, cam)
-            errs.append(abs(wrap180(est.heading_deg - p.yaw_deg)))
-            spreads.append(est.spread_deg)
-    return np.array(errs), np.array(spreads)
+    r = rotation_set_errors(load_rotation_set(real_data_dir / name), FeatureCompass())
+    return np.array(r["errors_deg"]), np.array([c["spread_deg"] for c in r["crops"]])
 
 
 def test_real_rotation_indoor(real_data_dir):

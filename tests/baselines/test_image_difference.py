@@ -13,7 +13,7 @@ from vc_gym.baselines.strip import angular_strip, strip_offsets
 from vc_gym.compass import Camera
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.experiments.real_data import load_rotation_set
-from vc_gym.experiments.real_rotation import crop_columns
+from vc_gym.experiments.real_rotation import rotation_set_errors
 from vc_gym.persistence import save_npz_atomic
 from vc_gym.worlds.panorama import render_view
 
@@ -222,16 +222,7 @@ def test_coarser_heading_grid(learn_views, room_pano):
 )
 def test_real_rotation_sets(real_data_dir, set_name, min_within_5):
     photos = load_rotation_set(real_data_dir / set_name)
-    c = ImageDifferenceCompass()
-    for p in photos[0::2]:
-        c.learn(p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg))
-    errors = []
-    for p in photos[1::2]:
-        w = p.image.shape[1]
-        for left in np.linspace(0, w - w // 2, 3).round().astype(int):
-            crop, cam = crop_columns(p, int(left), w // 2)
-            errors.append(abs(wrap180(c.estimate(crop, cam).heading_deg - p.yaw_deg)))
-    errors = np.array(errors)
+    errors = np.array(rotation_set_errors(photos, ImageDifferenceCompass())["errors_deg"])
     assert np.median(errors) < 1.0, errors
     assert np.mean(errors < 5.0) >= min_within_5, errors
 

@@ -12,7 +12,7 @@ from vc_gym.baselines.sector_colour import SectorColourCompass
 from vc_gym.compass import Camera
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.experiments.real_data import load_rotation_set
-from vc_gym.experiments.real_rotation import crop_columns
+from vc_gym.experiments.real_rotation import rotation_set_errors
 from vc_gym.worlds.panorama import render_view
 
 #: Learning yaws of tests/conftest.py: 8 body directions x 3 head pans (paper 4.3).
@@ -221,16 +221,7 @@ def real_sets(real_data_dir):
 def real_crop_errors(photos, **kwargs) -> np.ndarray:
     """evaluate_rotation_set's protocol: learn the even photos, 3 half-width crops
     of each odd photo."""
-    sc = SectorColourCompass(**kwargs)
-    for p in photos[0::2]:
-        sc.learn(p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg))
-    errs = []
-    for p in photos[1::2]:
-        w = p.image.shape[1]
-        for left in np.linspace(0, w - w // 2, 3).round().astype(int):
-            crop, cam = crop_columns(p, int(left), w // 2)
-            errs.append(abs(wrap180(sc.estimate(crop, cam).heading_deg - p.yaw_deg)))
-    return np.array(errs)
+    return np.array(rotation_set_errors(photos, SectorColourCompass(**kwargs))["errors_deg"])
 
 
 @pytest.mark.parametrize("model", ["gaussian", "histogram"])
