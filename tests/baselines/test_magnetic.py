@@ -93,3 +93,26 @@ def test_bad_readings_and_poses_are_refused():
             m.read(pose, rng)
     with pytest.raises(ValueError, match="Generator"):
         m.read((0.0, 0.0, 0.0), np.random.RandomState(0))
+
+
+def test_a_magnetometer_in_the_head_is_an_image_compass_reading_the_head_pose():
+    from vc_gym.baselines import MagnetometerCompass
+    from vc_gym.compass import Camera, ImageCompass
+    from vc_gym.localization import CompassHeadingSensor
+
+    head = [0.0, 0.0, 100.0]
+    m = MagnetometerCompass(
+        NoisyMagneticCompass(noise_deg=0.0), lambda: head, np.random.default_rng(0)
+    )
+    assert isinstance(m, ImageCompass)
+    frame = np.zeros((4, 4, 3), np.uint8)  # not looked at
+    assert m.estimate(frame, Camera()).heading_deg == pytest.approx(100.0, abs=0.05)
+    head[2] = 220.0  # the head turned: the next reading follows it
+    assert m.estimate(frame, Camera()).heading_deg == pytest.approx(220.0, abs=0.05)
+    # a tracker asks for body headings: the head pan is taken off
+    ll = CompassHeadingSensor(m, Camera()).heading_log_likelihood(frame, np.arange(360.0), 20.0)
+    assert int(np.argmax(ll)) == 200
+    with pytest.raises(ValueError, match="NoisyMagneticCompass"):
+        MagnetometerCompass("north", lambda: head, np.random.default_rng(0))
+    with pytest.raises(ValueError, match="callable"):
+        MagnetometerCompass(NoisyMagneticCompass(), head, np.random.default_rng(0))
