@@ -235,15 +235,18 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def _cmd_experiment(args: argparse.Namespace) -> int:
     if args.name in ("synthetic-compass", "real-rotation"):
         return _cmd_compass_experiment(args)
-    from vc_gym.experiments.runner import check_out_dir, make_backend
+    from vc_gym.experiments.output import new_out_dir
+    from vc_gym.experiments.runner import make_backend
     from vc_gym.experiments.studies import ExperimentOptions, get_experiment
 
     experiment = get_experiment(args.name)
     size = "quick" if args.quick else (args.size or "full")
-    out = check_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}")
     run = experiment.runner()
     options = _experiment_options(args, run)
-    with make_backend(args.backend, args.workers, args.address) as backend:
+    with (
+        new_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}") as out,
+        make_backend(args.backend, args.workers, args.address) as backend,
+    ):
         opts = ExperimentOptions(
             seed=args.seed,
             size=size,

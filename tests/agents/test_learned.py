@@ -50,3 +50,31 @@ def test_bad_configs_are_clear_errors(tmp_path, config, match):
     (tmp_path / "config.json").write_text(config)
     with pytest.raises(ValueError, match=match):
         LearnedHomingAgent(tmp_path / "model.zip")
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        ({"extra_kw": 3}, "unexpected keyword argument 'extra_kw'"),
+        ({"scene": "nowhere"}, "unknown scene 'nowhere'"),
+        ({"max_forward": -1}, "max_forward"),
+    ],
+)
+def test_env_arguments_the_env_refuses_name_the_config_file(tmp_path, capsys, change, match):
+    import shutil
+
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+
+    shutil.copytree(PRETRAINED_MODEL.parent, tmp_path / "agent")
+    cfg = tmp_path / "agent" / "config.json"
+    data = json.loads(cfg.read_text())
+    data["env"].update(change)
+    cfg.write_text(json.dumps(data))
+    agent = LearnedHomingAgent(tmp_path / "agent" / "model.zip")
+    with pytest.raises(ValueError, match=f"{cfg}: its env arguments .*{match}"):
+        agent.check_env()
+    # the command refuses it before any work, and leaves no output folder behind
+    out = tmp_path / "run"
+    argv = ["evaluate", "--agent", str(tmp_path / "agent" / "model.zip"), "--out", str(out)]
+    assert main(argv) == 2
+    assert str(cfg) in capsys.readouterr().err and not out.exists()

@@ -105,6 +105,27 @@ class LearnedHomingAgent:
         (e.g. ``tracker=``, ``stop_time_s=5.0``, ``relearn=``)."""
         return gym.make("vc_gym/Homing-v0", **{**self.env_kwargs, **overrides})
 
+    def check_env(self) -> None:
+        """Build (and close) the agent's env once, so that a ``config.json`` whose env
+        arguments the env refuses (an unknown key, scene or value) fails here, naming
+        the file, not later in every worker.
+
+        Raises
+        ------
+        ValueError
+            Naming ``config.json`` and what the env said.
+        """
+        cfg_path = self.path.with_name("config.json")
+        try:
+            env = self.make_env()
+        except Exception as exc:  # noqa: BLE001 - TypeError (a key), ValueError (a value)
+            cause = exc.__cause__ or exc
+            raise ValueError(
+                f"{cfg_path}: its env arguments are refused by vc_gym/Homing-v0: "
+                f"{type(cause).__name__}: {str(cause).split(' was raised from')[0]}"
+            ) from None
+        env.close()
+
     def predict(self, obs: np.ndarray) -> np.ndarray:
         """Deterministic action for one feature vector."""
         action, _ = self.model.predict(obs, deterministic=True)

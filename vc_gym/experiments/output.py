@@ -7,8 +7,10 @@ alive in pyplot's registry, so the package can plot inside a user's notebook ses
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +18,14 @@ from matplotlib.figure import Figure
 
 from vc_gym.persistence import write_atomic
 
-__all__ = ["check_out_dir", "check_out_file", "new_figure", "save_figure", "write_json"]
+__all__ = [
+    "check_out_dir",
+    "check_out_file",
+    "new_figure",
+    "new_out_dir",
+    "save_figure",
+    "write_json",
+]
 
 
 def check_out_dir(path: str | os.PathLike) -> Path:
@@ -38,6 +47,20 @@ def check_out_dir(path: str | os.PathLike) -> Path:
     except OSError as exc:
         raise ValueError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
     return out
+
+
+@contextlib.contextmanager
+def new_out_dir(path: str | os.PathLike) -> Iterator[Path]:
+    """:func:`check_out_dir` for a run: if the run fails before it writes anything, a
+    folder this call created is removed again (a refused argument leaves nothing)."""
+    existed = Path(path).exists()
+    out = check_out_dir(path)
+    try:
+        yield out
+    except BaseException:
+        if not existed and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()
+        raise
 
 
 def check_out_file(path: str | os.PathLike) -> Path:

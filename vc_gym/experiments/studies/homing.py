@@ -338,7 +338,9 @@ def run_homing(
         from vc_gym.agents.learned import LearnedHomingAgent
 
         agent = str(Path(agent).resolve())
-        scene = LearnedHomingAgent(agent).scene  # a bad model fails here, not in a worker
+        learned = LearnedHomingAgent(agent)  # a bad model fails here, not in a worker
+        learned.check_env()  # and so does a config.json the env refuses
+        scene = learned.scene
     else:
         from vc_gym.envs.scenes import check_scene_name
 
