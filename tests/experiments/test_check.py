@@ -13,8 +13,8 @@ def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
     code = main(["check", "--soak-steps", "40", "--soak-cycles", "10", "--out", str(out)])
     r = json.loads(out.read_text())
     assert code == 0, r["failures"]
-    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 40
-    assert set(r["suites"]) == {"bad_input", "hostile_file", "fault"}
+    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 70
+    assert set(r["suites"]) == {"bad_input", "hostile_file", "sensors", "fault"}
     assert r["soak"]["steps"] == 40 and r["soak"]["median_steps_per_s"] > 0
     assert "failed 0" in capsys.readouterr().out
 

@@ -34,9 +34,10 @@ from tqdm import tqdm
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.agents.learned import PRETRAINED_MODEL
 from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
+from vc_gym.baselines import load_sensor, make_sensor
 from vc_gym.compass import Camera, CompassConfig, VisualCompass
 from vc_gym.config_files import read_settings
-from vc_gym.errors import MapFileError
+from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.experiments.runner import ExperimentRun, Job, LocalBackend
 from vc_gym.experiments.soak import soak
 from vc_gym.experiments.training import TrainConfig
@@ -345,6 +346,110 @@ def _hostile_file_cases() -> list[Case]:
     ]
 
 
+# --------------------------------------------------------------------------- sensors
+#: The image baselines the sensor suite checks, by their registry name.
+_IMAGE_BASELINES = ("image_difference", "sector_colour", "feature")
+
+
+@functools.cache
+def _learned_baseline(name: str) -> Any:
+    """A baseline learned on the synthetic room panorama (built once per process)."""
+    pano = make_panorama(np.random.default_rng(7), width=1200, height=300, kind="room")
+    sensor = make_sensor(name)
+    for a in range(0, 360, 30):
+        sensor.learn(render_view(pano, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+    return sensor
+
+
+def _baseline_file(name: str, tmp: Path) -> Path:
+    return _learned_baseline(name).save(tmp / f"{name}.npz")
+
+
+def _baseline_bit_flips(name: str) -> Callable[[Path], None]:
+    def run(tmp: Path) -> None:
+        data = _baseline_file(name, tmp).read_bytes()
+        cls = type(_learned_baseline(name))
+        for i in range(0, len(data), max(1, len(data) // 30)):
+            flipped = bytearray(data)
+            flipped[i] ^= 0xFF
+            path = tmp / "flipped.npz"
+            path.write_bytes(bytes(flipped))
+            try:
+                cls.load(path)
+            except MapFileError:
+                pass  # anything else escapes and fails the case
+
+    return run
+
+
+def _baseline_other_file(name: str) -> Callable[[Path], None]:
+    def run(tmp: Path) -> None:
+        other = "feature" if name != "feature" else "image_difference"
+        path = _baseline_file(other, tmp)
+        _raises(MapFileError, path.name, lambda: load_sensor(name, path))
+
+    return run
+
+
+def _baseline_tampered(name: str) -> Callable[[Path], None]:
+    def run(tmp: Path) -> None:
+        path = _baseline_file(name, tmp)
+        with np.load(path) as f:  # the file is ours: plain arrays only
+            arrays = {k: f[k] for k in f.files if k not in ("schema", "schema_version")}
+        key = next(k for k in arrays if arrays[k].dtype.kind == "f" and arrays[k].size > 1)
+        arrays[key] = np.full_like(arrays[key], np.nan)
+        bad = save_npz_atomic(tmp / "tampered.npz", type(_learned_baseline(name)).schema, 1, arrays)
+        _raises(MapFileError, "tampered.npz", lambda: load_sensor(name, bad))
+
+    return run
+
+
+def _sensor_cases() -> list[Case]:
+    image = np.zeros((160, 208, 3), np.uint8)
+    cases = []
+    for name in _IMAGE_BASELINES:
+        sensor = functools.partial(_learned_baseline, name)
+        simple = {
+            "float image": lambda s=sensor: s().log_likelihood(image.astype(np.float32), Camera()),
+            "grey image": lambda s=sensor: s().log_likelihood(image[:, :, 0], Camera()),
+            "camera not a Camera": lambda s=sensor: s().log_likelihood(image, "cam"),
+            "learn a float image": lambda s=sensor: s().learn(image.astype(float), Camera()),
+            "heading step 7": lambda n=name: make_sensor({"type": n, "heading_step_deg": 7.0}),
+            "heading step NaN": lambda n=name: make_sensor(
+                {"type": n, "heading_step_deg": float("nan")}
+            ),
+        }
+        cases += [
+            Case("sensors", f"{name}: {what}", lambda _, fn=fn: _raises(ValueError, "", fn))
+            for what, fn in simple.items()
+        ]
+        cases += [
+            Case(
+                "sensors",
+                f"{name}: estimate before learning",
+                lambda _, n=name: _raises(
+                    NotLearnedError, "", lambda: make_sensor(n).estimate(image, Camera())
+                ),
+            ),
+            Case("sensors", f"{name}: file with bit flips", _baseline_bit_flips(name)),
+            Case("sensors", f"{name}: another sensor's file", _baseline_other_file(name)),
+            Case("sensors", f"{name}: file with NaN entries", _baseline_tampered(name)),
+        ]
+    magnetic = {
+        "magnetometer: NaN reading": lambda: make_sensor("magnetic").log_likelihood(np.nan),
+        "magnetometer: noise -1": lambda: make_sensor({"type": "magnetic", "noise_deg": -1}),
+        "magnetometer: pose with inf": lambda: make_sensor("magnetic").read(
+            (0.0, np.inf, 0.0), np.random.default_rng(0)
+        ),
+        "sensor 'nope'": lambda: make_sensor("nope"),
+    }
+    cases += [
+        Case("sensors", what, lambda _, fn=fn: _raises(ValueError, "", fn))
+        for what, fn in magnetic.items()
+    ]
+    return cases
+
+
 # --------------------------------------------------------------------------- faults
 def die_once(marker: str) -> dict[str, Any]:
     """Job: the worker process dies the first time (as if OOM-killed), succeeds after."""
@@ -421,7 +526,7 @@ def _fault_cases() -> list[Case]:
 
 def all_cases() -> list[Case]:
     """Every case of every suite (built on demand: some import heavy modules)."""
-    return [*_bad_input_cases(), *_hostile_file_cases(), *_fault_cases()]
+    return [*_bad_input_cases(), *_hostile_file_cases(), *_sensor_cases(), *_fault_cases()]
 
 
 def run_check(
