@@ -102,8 +102,9 @@ EXPERIMENTS: dict[str, Experiment] = {
             "the baselines of section 6 under one protocol: the visual compass (paper and "
             "improved), image difference, sector colours, ORB features and a disturbed "
             "magnetometer learn the same frames; median/p90 heading error at 0, 1, 2 and "
-            "4 m, full and half light, every scene, and on the real photos; ms per frame "
-            "and the accuracy/cost front (sensors.png)",
+            "4 m, full and half light, every scene, and on the real photos; homing with "
+            "each as the tracker's heading sensor; ms per frame and the accuracy/cost "
+            "front (sensors.png)",
         ),
         Experiment(
             "paper",
