@@ -12,7 +12,24 @@ import math
 
 from vc_gym.angles import wrap360
 
-__all__ = ["body_to_world", "compose", "world_to_body"]
+__all__ = ["body_to_world", "check_pose", "compose", "world_to_body"]
+
+
+def check_pose(pose: object) -> tuple[float, float, float]:
+    """``pose`` as three finite floats ``(x m, y m, θ deg)``.
+
+    Raises
+    ------
+    ValueError
+        If ``pose`` is not three numbers, or one of them is NaN or infinite.
+    """
+    try:
+        x, y, theta = (float(v) for v in pose)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise ValueError(f"pose must be (x, y, heading_deg), got {pose!r}") from None
+    if not all(math.isfinite(v) for v in (x, y, theta)):
+        raise ValueError(f"pose must be 3 finite numbers, got {pose!r}")
+    return x, y, theta
 
 
 def body_to_world(forward: float, left: float, heading_deg: float) -> tuple[float, float]:

@@ -11,7 +11,6 @@ wrong.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -20,6 +19,7 @@ import numpy as np
 from vc_gym.angles import wrap180, wrap360
 from vc_gym.baselines.base import estimate_of, heading_grid
 from vc_gym.compass import Camera, CompassEstimate
+from vc_gym.poses import check_pose
 from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
 
 __all__ = ["DisturbanceSource", "MagnetometerCompass", "NoisyMagneticCompass"]
@@ -152,12 +152,7 @@ class NoisyMagneticCompass:
         """The reading at the true pose ``(x, y, θ_deg)`` (degrees in ``[0, 360)``)."""
         if not isinstance(rng, np.random.Generator):
             raise ValueError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
-        try:
-            x, y, theta = (float(v) for v in pose)
-        except (TypeError, ValueError):
-            raise ValueError(f"pose must be (x, y, heading_deg), got {pose!r}") from None
-        if not all(math.isfinite(v) for v in (x, y, theta)):
-            raise ValueError(f"pose must be finite, got {pose!r}")
+        x, y, theta = check_pose(pose)
         noise = rng.normal(0.0, self.noise_deg) if self.noise_deg > 0 else 0.0
         return float(wrap360(theta + float(self.disturbance_deg(x, y)) + noise))
 

@@ -17,6 +17,7 @@ from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
 from vc_gym.envs.scenes import Scene, build_scene, check_scene_name
 from vc_gym.envs.top_view import TopView
+from vc_gym.poses import check_pose
 from vc_gym.validation import positive_float
 
 __all__ = ["AiboRoomEnv", "MAX_ILLUMINATION", "ROBOT_CLEARANCE_M"]
@@ -265,9 +266,7 @@ class AiboRoomEnv(gym.Env):
             self._build(scene_seed)
             self._scene_key = key
         if "pose" in options:
-            x, y, yaw = (float(v) for v in options["pose"])
-            if not all(math.isfinite(v) for v in (x, y, yaw)):
-                raise ValueError(f"pose must be 3 finite numbers, got {options['pose']!r}")
+            x, y, yaw = check_pose(options["pose"])
             if not self.inside_walls(x, y):
                 raise ValueError(
                     f"pose {options['pose']!r} is not inside the walls of {self.scene_name!r} "

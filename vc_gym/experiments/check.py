@@ -248,18 +248,24 @@ def _object_array(tmp: Path) -> None:
     _refused(_write_zip(tmp / "objects.npz", entries))
 
 
-def _bit_flips(tmp: Path) -> None:
-    good = save_npz_atomic(tmp / "good.npz", "vc_gym.Check", 1, {"a": np.arange(50.0)})
+def _load_bit_flipped(good: Path, flips: int, load: Callable[[Path], object], tmp: Path) -> None:
+    """Flip one byte at ``flips`` places of the file ``good`` in turn and ``load`` each
+    copy: only :class:`MapFileError` may come out (anything else fails the case)."""
     data = good.read_bytes()
-    for i in range(0, len(data), max(1, len(data) // 40)):
+    for i in range(0, len(data), max(1, len(data) // flips)):
         flipped = bytearray(data)
         flipped[i] ^= 0xFF
         path = tmp / "flipped.npz"
         path.write_bytes(bytes(flipped))
         try:
-            load_npz_checked(path, "vc_gym.Check", 1)
+            load(path)
         except MapFileError:
-            pass  # anything else escapes and fails the case
+            pass
+
+
+def _bit_flips(tmp: Path) -> None:
+    good = save_npz_atomic(tmp / "good.npz", "vc_gym.Check", 1, {"a": np.arange(50.0)})
+    _load_bit_flipped(good, 40, lambda p: load_npz_checked(p, "vc_gym.Check", 1), tmp)
 
 
 def _renamed_npy(tmp: Path) -> None:
@@ -367,17 +373,8 @@ def _baseline_file(name: str, tmp: Path) -> Path:
 
 def _baseline_bit_flips(name: str) -> Callable[[Path], None]:
     def run(tmp: Path) -> None:
-        data = _baseline_file(name, tmp).read_bytes()
         cls = type(_learned_baseline(name))
-        for i in range(0, len(data), max(1, len(data) // 30)):
-            flipped = bytearray(data)
-            flipped[i] ^= 0xFF
-            path = tmp / "flipped.npz"
-            path.write_bytes(bytes(flipped))
-            try:
-                cls.load(path)
-            except MapFileError:
-                pass  # anything else escapes and fails the case
+        _load_bit_flipped(_baseline_file(name, tmp), 30, cls.load, tmp)
 
     return run
 

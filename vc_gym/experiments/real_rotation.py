@@ -133,11 +133,16 @@ def evaluate_rotation_set(
     """
     vc = VisualCompass(config)
 
-    def prepare(sensor: ImageCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
-        vc.fit_colors([image for image, _ in frames])
-        _learn_all(vc, frames)
+    def fit_colours(sensor: VisualCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
+        sensor.fit_colors([image for image, _ in frames])
 
-    r = rotation_set_errors(photos, vc, prepare, crop_width_frac, crops_per_photo)
+    r = rotation_set_errors(
+        photos,
+        vc,
+        crop_width_frac=crop_width_frac,
+        crops_per_photo=crops_per_photo,
+        setup=fit_colours,
+    )
     e = np.array(r["errors_deg"])
     return {
         "median_error_deg": float(np.median(e)),

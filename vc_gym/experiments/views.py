@@ -48,6 +48,7 @@ from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.learning import HEAD_SCAN_DEG, RobotFell
 from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.localization import TrackerSpec, make_tracker
+from vc_gym.poses import check_pose
 from vc_gym.validation import finite_float, positive_float
 
 __all__ = [
@@ -292,12 +293,7 @@ def look(
     env = getattr(room, "unwrapped", room)
     if not isinstance(env, AiboRoomEnv):
         raise ValueError(f"room must be an AiboRoomEnv, got {type(room).__name__}")
-    try:
-        x, y, yaw = (float(v) for v in pose)
-    except (TypeError, ValueError):
-        raise ValueError(f"pose must be (x, y, yaw_deg), got {pose!r}") from None
-    if not all(math.isfinite(v) for v in (x, y, yaw)):
-        raise ValueError(f"pose must be 3 finite numbers, got {pose!r}")
+    x, y, yaw = check_pose(pose)
     n = _int_at_least("frames", frames, 1)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be an int >= 0, got {seed!r}")

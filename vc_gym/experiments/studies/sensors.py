@@ -126,6 +126,12 @@ def view_poses_at(
     return poses
 
 
+def _is_magnetic(spec: Any) -> bool:
+    """Whether a sensor spec names the magnetometer (it reads poses, not images)."""
+    kind = spec.get("type") if isinstance(spec, Mapping) else spec
+    return kind == "magnetic"
+
+
 def _magnetometer(scene: str, bounds: Sequence[float], seed: int) -> NoisyMagneticCompass:
     rng = np.random.default_rng([seed, 97, zlib.crc32(scene.encode())])
     return NoisyMagneticCompass.random_field(bounds, rng, **MAGNETIC_FIELD)
@@ -151,7 +157,7 @@ def sensors_scene_job(
     camera = learning[0][1].replace(yaw_deg=0.0)
     built, timing = {}, {}
     for name, spec in sensors.items():
-        if spec == "magnetic" or (isinstance(spec, Mapping) and spec.get("type") == "magnetic"):
+        if _is_magnetic(spec):
             built[name] = _magnetometer(scene, bounds, seed)
             continue
         sensor = make_sensor(spec)
@@ -187,7 +193,7 @@ def sensors_real_job(folder: str, sensors: dict[str, Any]) -> dict[str, Any]:
     photos = load_rotation_set(folder)
     out, timing = {}, {}
     for name, spec in sensors.items():
-        if spec == "magnetic" or (isinstance(spec, Mapping) and spec.get("type") == "magnetic"):
+        if _is_magnetic(spec):
             continue
         r = rotation_set_errors(photos, make_sensor(spec), prepare=teach, setup=fit_colours)
         e = np.asarray(r["errors_deg"])
