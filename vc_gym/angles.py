@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 __all__ = [
+    "MIN_HEADING_STEP_DEG",
     "wrap180",
     "wrap360",
     "circular_mean",
@@ -21,6 +22,11 @@ __all__ = [
     "interp_circular",
     "peak_headings",
 ]
+
+
+#: The finest heading grid any sensor takes (36,000 headings): a config, perhaps read
+#: from a file, cannot make it allocate more.
+MIN_HEADING_STEP_DEG = 0.01
 
 
 def wrap180(angle_deg: ArrayLike) -> np.ndarray | float:

@@ -109,3 +109,16 @@ def test_a_saved_sensor_is_a_grid_trackers_heading_sensor(room_pano, tmp_path):
         load_sensor("magnetic", path)
     with pytest.raises(MapFileError, match="home.npz"):
         load_sensor("feature", path)  # another sensor's file
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        {"type": "magnetic", "heading_step_deg": 1e-6},  # would be 3.6e8 headings
+        {"type": "image_difference", "heading_step_deg": 0.001},
+        {"type": "sector_colour", "el_step_deg": 1e-9},
+    ],
+)
+def test_a_config_cannot_make_a_sensor_exhaust_memory(spec):
+    with pytest.raises(ValueError, match="heading_step_deg must be >=|elevation rows"):
+        make_sensor(spec)

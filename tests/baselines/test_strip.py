@@ -81,3 +81,15 @@ def test_offsets_cover_the_view():
 def test_bad_grids_are_refused(kwargs):
     with pytest.raises(ValueError):
         StripGrid(**kwargs)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"el_step_deg": 1e-9}, "elevation rows"),  # would be 4e10 rows
+        ({"az_step_deg": 1e-6}, "az_step_deg must be >="),  # would be 3.6e8 azimuths
+    ],
+)
+def test_a_grid_cannot_be_made_to_exhaust_memory(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        StripGrid(**kwargs)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -251,6 +253,7 @@ def test_config_validation():
         {"coverage": 1e-9},  # used to learn nothing
         {"coverage": 0.0009},
         {"heading_step_deg": 0.7},
+        {"heading_step_deg": 1e-9},  # divides 360, but 3.6e11 headings
         {"smoothing": -1.0},
         {"temperature": 0.0},
         {"n_colors": 2.5},
@@ -319,6 +322,12 @@ def test_load_rejects_other_version_schema_and_config(tmp_path, room_compass):
         VisualCompass.load(
             _rewrite(path, tmp_path / "n.npz", colors_means=np.full((10, 3), np.nan))
         )
+    # a config that would allocate 3.6e11 headings is refused, not obeyed
+    with np.load(path) as d:
+        cfg = json.loads(str(d["config"]))
+    cfg["heading_step_deg"] = 1e-9
+    with pytest.raises(MapFileError, match="heading_step_deg"):
+        VisualCompass.load(_rewrite(path, tmp_path / "h.npz", config=np.array(json.dumps(cfg))))
 
 
 def test_load_never_unpickles(tmp_path, room_compass):

@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from vc_gym.angles import circular_std_rows, interp_circular, peak_headings
+from vc_gym.angles import MIN_HEADING_STEP_DEG, circular_std_rows, interp_circular, peak_headings
 from vc_gym.compass import Camera, CompassEstimate
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.filters.protocol import check_log_likelihood
@@ -38,8 +38,10 @@ def check_camera(camera: object) -> Camera:
 
 def heading_grid(step_deg: float) -> np.ndarray:
     """The read-only heading grid ``0, step, ..., 360 - step`` (``step`` must divide 360
-    and be at most 90°)."""
+    and lie in ``[MIN_HEADING_STEP_DEG, 90]``)."""
     step = positive_float("heading_step_deg", step_deg)
+    if step < MIN_HEADING_STEP_DEG:
+        raise ValueError(f"heading_step_deg must be >= {MIN_HEADING_STEP_DEG}, got {step}")
     n = 360.0 / step
     if step > 90.0 or abs(n - round(n)) > 1e-9:
         raise ValueError(f"heading_step_deg must divide 360 (and be <= 90), got {step}")

@@ -27,8 +27,6 @@ __all__ = ["ImageDifferenceCompass", "NORMALIZATIONS"]
 NORMALIZATIONS = ("mean", "none", "local")
 #: A mean intensity below this many grey levels is black: it is not divided by.
 _DARK = 1e-3
-#: Most elevation rows a strip may have (a tiny ``el_step_deg`` is a mistake).
-_MAX_ROWS = 1000
 # Rows of the per-row spectra stack: m, m |v|^2, m v_r, m v_g, m v_b (v = q or P).
 _M, _M2, _RGB = 0, 1, slice(2, 5)
 
@@ -145,11 +143,7 @@ class ImageDifferenceCompass(BaselineCompass):
         lo = finite_real("el_min_deg", el_min_deg)
         hi = finite_real("el_max_deg", el_max_deg)
         step = positive_float("el_step_deg", el_step_deg)
-        if (hi - lo) / step >= _MAX_ROWS:
-            raise ValueError(
-                f"el_step_deg={step} gives more than {_MAX_ROWS} elevation rows in [{lo}, {hi}]"
-            )
-        self._grid = StripGrid(self.heading_step_deg, lo, hi, step)
+        self._grid = StripGrid(self.heading_step_deg, lo, hi, step)  # bounds the rows too
         if not isinstance(normalize, str) or normalize not in NORMALIZATIONS:
             raise ValueError(f"normalize must be one of {NORMALIZATIONS}, got {normalize!r}")
         self.normalize = normalize

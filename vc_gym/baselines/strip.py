@@ -21,7 +21,12 @@ import numpy as np
 from vc_gym.compass import Camera
 from vc_gym.validation import finite_float, positive_float
 
-__all__ = ["StripGrid", "angular_strip", "strip_offsets"]
+__all__ = ["MAX_ROWS", "MIN_AZ_STEP_DEG", "StripGrid", "angular_strip", "strip_offsets"]
+
+#: Most elevation rows and finest azimuth step of a grid: a config, perhaps read from a
+#: file, cannot make a strip or a panorama allocate more than 1000 x 36,000 samples.
+MAX_ROWS = 1000
+MIN_AZ_STEP_DEG = 0.01
 
 
 @dataclass(frozen=True)
@@ -45,6 +50,8 @@ class StripGrid:
 
     def __post_init__(self) -> None:
         az = positive_float("az_step_deg", self.az_step_deg)
+        if az < MIN_AZ_STEP_DEG:
+            raise ValueError(f"az_step_deg must be >= {MIN_AZ_STEP_DEG}, got {az}")
         n = 360.0 / az
         if az > 45.0 or abs(n - round(n)) > 1e-9:
             raise ValueError(f"az_step_deg must divide 360 (and be <= 45), got {az}")
@@ -52,7 +59,11 @@ class StripGrid:
         hi = finite_float("el_max_deg", self.el_max_deg)
         if not -90.0 < lo < hi < 90.0:
             raise ValueError(f"need -90 < el_min_deg < el_max_deg < 90, got {lo}, {hi}")
-        positive_float("el_step_deg", self.el_step_deg)
+        step = positive_float("el_step_deg", self.el_step_deg)
+        if (hi - lo) / step >= MAX_ROWS:
+            raise ValueError(
+                f"el_step_deg={step} gives more than {MAX_ROWS} elevation rows in [{lo}, {hi}]"
+            )
 
     @property
     def n_azimuths(self) -> int:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, fields
 
+from vc_gym.angles import MIN_HEADING_STEP_DEG
+
 __all__ = ["CompassConfig", "EXPOSURE_MODES", "MIN_COVERAGE"]
 
 #: Accepted values of :attr:`CompassConfig.exposure`.
@@ -94,9 +96,12 @@ class CompassConfig:
         if not MIN_COVERAGE <= self.coverage <= 1:
             # below it the grid's steps exceed a small image: it would learn nothing
             raise ValueError(f"coverage must be in [{MIN_COVERAGE}, 1], got {self.coverage}")
-        if not 0 < self.heading_step_deg <= 90 or not _is_divisor_of_360(self.heading_step_deg):
+        step = self.heading_step_deg
+        if not MIN_HEADING_STEP_DEG <= step <= 90 or not _is_divisor_of_360(step):
+            # a map file's config must not make the compass allocate 360 / 1e-9 headings
             raise ValueError(
-                f"heading_step_deg must be in (0, 90] and divide 360, got {self.heading_step_deg}"
+                f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG}, 90] and divide 360, "
+                f"got {step}"
             )
         if self.smoothing <= 0:
             raise ValueError(f"smoothing must be > 0, got {self.smoothing}")
