@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassAtlas, CompassConfig, NotLearnedError, VisualCompass
+from vc_gym.compass import (
+    Camera,
+    CompassAtlas,
+    CompassConfig,
+    NotLearnedError,
+    VisualCompass,
+    visual_compass,
+)
 from vc_gym.worlds.room import render_room_view
 
 TEST_YAWS = (10.0, 100.0, 200.0, 290.0)
@@ -157,3 +164,19 @@ def test_a_narrow_normalisation_kernel_keeps_the_position_finite(atlas, room):
     est = fresh.estimate_position(render_room_view(room, 0.3, 0.2, Camera(yaw_deg=75.0)), Camera())
     assert np.all(np.isfinite(est.position))
     assert all(math.isfinite(g) and g > 0 for g in est.goodness.values())
+
+
+@pytest.mark.parametrize("gather_bytes", [1, 1 << 12, 1 << 40])
+def test_scores_do_not_depend_on_how_many_rows_are_gathered_at_once(
+    atlas, room, monkeypatch, gather_bytes
+):
+    # one group per gather, a few groups, and every row at once give the same sums
+    image = render_room_view(room, 0.3, 0.6, Camera(yaw_deg=75.0))
+    raw, full = atlas.scores(image, Camera())
+    monkeypatch.setattr(visual_compass, "_GATHER_BYTES", gather_bytes)
+    raw2, full2 = atlas.scores(image, Camera())
+    np.testing.assert_array_equal(raw2, raw)
+    for a, b in zip(full, full2, strict=True):
+        np.testing.assert_array_equal(a.log_likelihood, b.log_likelihood)
+    part = atlas.scores(image, Camera(), spots=[1])[1][0]
+    np.testing.assert_array_equal(part.log_likelihood, full[1].log_likelihood)
