@@ -61,6 +61,7 @@ _TRAIN_FIELDS = {
     "eval_episodes": "eval_episodes",
     "save_freq": "save_freq",
     "demo_episodes": "demo_episodes",
+    "places": "places",
 }
 
 
@@ -671,6 +672,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="scene to train in (default: robolab): %(choices)s",
     )
     p.add_argument("--learn-time", type=float, help="seconds per learning direction (default 5)")
+    p.add_argument(
+        "--places",
+        type=_int_list,
+        metavar="S,S,...",
+        help="train over a pool of places: the learning seeds of the places, each learned "
+        "once (DIR/atlas-place<s>.npz), every episode in one of them (default: the one "
+        "place of --seed)",
+    )
     p.add_argument(
         "--tracker",
         metavar="NAME",

@@ -276,3 +276,39 @@ def test_a_bad_scene_or_tracker_in_a_config_file_fails_before_the_run_folder(
     out = tmp_path / "run"
     assert main(["train", "--config", str(cfg), "--out", str(out)]) == 2
     assert value in capsys.readouterr().err and not out.exists()
+
+
+def test_places_are_checked_and_saved():
+    assert TINY.place_seeds == (0,) and TINY.places == ()
+    config = replace(TINY, places=[3, 1])
+    assert config.places == (3, 1) and config.place_seeds == (3, 1)
+    assert TrainConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
+    assert [p.name for p in config.atlas_files("run")] == [
+        "atlas-place3.npz",
+        "atlas-place1.npz",
+    ]
+    for bad in ([1, 1], [-1], "12", [0.5], 3, list(range(17))):
+        with pytest.raises(ValueError, match="places"):
+            replace(TINY, places=bad)
+
+
+def test_training_over_a_pool_of_places(tmp_path):
+    config = replace(
+        TINY,
+        places=(0, 1),
+        n_envs=1,
+        vec_env="dummy",
+        timesteps=32,
+        eval_freq=0,
+        save_freq=0,
+    )
+    summary = train(config, tmp_path, progress=False)
+    # each place learned once, in its own file; the policy trained on both
+    assert (tmp_path / "atlas-place0.npz").is_file() and (tmp_path / "atlas-place1.npz").is_file()
+    assert not (tmp_path / "atlas.npz").exists()
+    assert summary["episodes"] > 0
+    saved = json.loads((tmp_path / "config.json").read_text())
+    assert saved["places"] == [0, 1] and TrainConfig.from_dict(saved) == config
+    # the agent's env is the task env of one place: the env arguments are the same
+    agent = LearnedHomingAgent(tmp_path / "model.zip")
+    assert agent.env_kwargs == config.env_kwargs()

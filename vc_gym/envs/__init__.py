@@ -20,6 +20,7 @@ from vc_gym.envs.learning import (
     SpotLearning,
     kidnap_pose,
 )
+from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
 from vc_gym.envs.scenes import (
     SCENES,
@@ -44,6 +45,7 @@ __all__ = [
     "LearningConfig",
     "LearningResult",
     "OdometryNoise",
+    "PlacePool",
     "Quadruped",
     "RobotFell",
     "Scene",

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.experiments.training import TrainConfig, learn_place, train, training_env
+from vc_gym.experiments.training import TrainConfig, learn_places, train, training_env
 from vc_gym.validation import int_at_least
 
 __all__ = ["bench_train"]
@@ -77,7 +77,7 @@ def bench_train(
     )
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
         atlas_file = Path(tmp) / "atlas.npz"
-        learn_place(config, atlas_file)
+        learn_places(config, atlas_file)
         before = _env_rate(config, atlas_file, env_steps, seed)
         run = train(config, tmp, progress=progress)
         after = _env_rate(config, atlas_file, env_steps, seed + 1)

@@ -13,6 +13,7 @@ import json
 import os
 import time
 import warnings
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,7 @@ from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
 from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
+from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
@@ -36,6 +38,8 @@ __all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
 CONFIG_SCHEMA = 2
 #: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
 DEFAULT_DEMO_EPISODES = {"ppo": 60, "sac": 0}
+#: At most this many places per training run (each is a PyBullet world in every worker).
+MAX_PLACES = 16
 
 #: The PPO policy shipped with the package (trained by ``vc-gym train``, see README);
 #: ``vc-gym evaluate --agent pretrained`` evaluates it.
@@ -55,9 +59,15 @@ class TrainConfig:
     n_envs : int
         Parallel environments (one worker process each with ``vec_env="subproc"``).
     seed : int
-        Seed of the model and of the environments (env ``i`` gets ``seed + i``) and of
-        the learning phase, which runs once per training run (``DIR/atlas.npz``, shared
-        by every worker; see ``atlas_file`` of ``vc_gym/LearnThenHome-v0``).
+        Seed of the model and of the environments (env ``i`` gets ``seed + i``) and,
+        without ``places``, of the learning phase, which runs once per training run
+        (``DIR/atlas.npz``, shared by every worker; see ``atlas_file`` of
+        ``vc_gym/LearnThenHome-v0``).
+    places : tuple of int
+        Train over a pool of places: the learning seeds of the places, each learned once
+        (``DIR/atlas-place<s>.npz``); every episode happens in one of them, drawn at
+        reset (:class:`~vc_gym.envs.PlacePool`). Empty (default): the one place of
+        ``seed``.
     scene : str
         Scene of ``vc_gym/LearnThenHome-v0``.
     learn_time_s, success_radius_m, max_homing_s : float
@@ -110,6 +120,7 @@ class TrainConfig:
     timesteps: int = 60_000
     n_envs: int = 2
     seed: int = 0
+    places: tuple[int, ...] = ()
     scene: str = "robolab"
     learn_time_s: float = 5.0
     stop_time_s: float = 0.1
@@ -162,6 +173,29 @@ class TrainConfig:
         if not self.net_arch or any(int(n) < 1 for n in self.net_arch):
             raise ValueError(f"net_arch must be positive layer sizes, got {self.net_arch!r}")
         object.__setattr__(self, "net_arch", tuple(int(n) for n in self.net_arch))
+        places = self.places
+        if isinstance(places, (str, bytes)) or not hasattr(places, "__iter__"):
+            raise ValueError(f"places must be a sequence of learning seeds, got {places!r}")
+        places = tuple(places)
+        for s in places:
+            int_at_least("places entry", s, 0)
+        if len(set(places)) != len(places) or len(places) > MAX_PLACES:
+            raise ValueError(
+                f"places must be at most {MAX_PLACES} distinct learning seeds, got {places!r}"
+            )
+        object.__setattr__(self, "places", tuple(int(s) for s in places))
+
+    @property
+    def place_seeds(self) -> tuple[int, ...]:
+        """The learning seeds of the places trained in (``places``, or ``(seed,)``)."""
+        return self.places or (self.seed,)
+
+    def atlas_files(self, out_dir: str | os.PathLike) -> list[Path]:
+        """Where the run in ``out_dir`` keeps each place's atlas (one per place seed)."""
+        out = Path(out_dir)
+        if not self.places:
+            return [out / "atlas.npz"]
+        return [out / f"atlas-place{s}.npz" for s in self.places]
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (with the schema version)."""
@@ -169,6 +203,7 @@ class TrainConfig:
             "schema": CONFIG_SCHEMA,
             **asdict(self),
             "net_arch": list(self.net_arch),
+            "places": list(self.places),
             "env": self.env_kwargs(),
         }
 
@@ -197,23 +232,32 @@ class TrainConfig:
         unknown = set(data) - known
         if unknown:
             raise ValueError(f"unknown config keys {sorted(unknown)}")
-        if "net_arch" in data:
-            data["net_arch"] = tuple(data["net_arch"])
+        for name in ("net_arch", "places"):
+            if isinstance(data.get(name), list):
+                data[name] = tuple(data[name])
         config = cls(**data)
         if env is not None and env != config.env_kwargs():
             raise ValueError("the config's 'env' does not match its own fields")
         return config
 
 
-def training_env(config: TrainConfig, atlas_file: str | os.PathLike) -> gym.Env:
-    """``vc_gym/Homing-v0`` as ``config`` trains on it, loading the place learned once
-    into ``atlas_file`` (learning seed: the run's seed; the first env learns it)."""
-    return gym.make(
-        "vc_gym/Homing-v0",
-        **config.env_kwargs(),
-        atlas_file=str(atlas_file),
-        learning_seed=config.seed,
-    )
+def training_env(
+    config: TrainConfig, atlas_files: str | os.PathLike | Sequence[str | os.PathLike]
+) -> gym.Env:
+    """``vc_gym/Homing-v0`` as ``config`` trains on it: one env per place
+    (:attr:`TrainConfig.place_seeds`), each loading its place, learned once, from its
+    entry of ``atlas_files`` (the first env that needs a place learns it); several
+    places make a :class:`~vc_gym.envs.PlacePool`."""
+    if isinstance(atlas_files, (str, os.PathLike)):
+        atlas_files = [atlas_files]
+    seeds = config.place_seeds
+    if len(atlas_files) != len(seeds):
+        raise ValueError(f"need one atlas file per place {seeds}, got {len(atlas_files)}")
+    envs = [
+        gym.make("vc_gym/Homing-v0", **config.env_kwargs(), atlas_file=str(f), learning_seed=seed)
+        for seed, f in zip(seeds, atlas_files, strict=True)
+    ]
+    return envs[0] if len(envs) == 1 else PlacePool(envs)
 
 
 def check_names(config: TrainConfig) -> None:
@@ -222,15 +266,23 @@ def check_names(config: TrainConfig) -> None:
     make_tracker(config.tracker)
 
 
-def learn_place(config: TrainConfig, atlas_file: str | os.PathLike) -> bool:
-    """Run the learning phase of ``config``'s env once, into ``atlas_file`` (kept if it is
-    there already and was learned the same way). Returns whether it learned."""
-    env = training_env(config, atlas_file)
-    try:
-        env.reset(seed=config.seed)
-        return bool(env.unwrapped.learner.learned)
-    finally:
-        env.close()
+def learn_places(
+    config: TrainConfig, atlas_files: str | os.PathLike | Sequence[str | os.PathLike]
+) -> int:
+    """Run the learning phase of each of ``config``'s places once, into its entry of
+    ``atlas_files`` (kept if it is there already and was learned the same way). Returns
+    how many places were learned now."""
+    if isinstance(atlas_files, (str, os.PathLike)):
+        atlas_files = [atlas_files]
+    learned = 0
+    for seed, f in zip(config.place_seeds, atlas_files, strict=True):
+        env = training_env(replace(config, places=(), seed=seed), f)
+        try:
+            env.reset(seed=seed)
+            learned += bool(env.unwrapped.learner.learned)
+        finally:
+            env.close()
+    return learned
 
 
 def read_train_config(path: str | os.PathLike, **overrides: Any) -> TrainConfig:
@@ -258,18 +310,18 @@ class _EnvFactory:
         self,
         config: TrainConfig,
         rank: int,
-        atlas_file: str | os.PathLike,
+        atlas_files: Sequence[Path],
         monitor: str | os.PathLike | None = None,
         append: bool = False,
     ):
-        self.config, self.rank, self.atlas_file = config, rank, atlas_file
+        self.config, self.rank, self.atlas_files = config, rank, atlas_files
         self.monitor, self.append = monitor, append
 
     def __call__(self) -> gym.Env:
         from stable_baselines3.common.monitor import Monitor
 
         env = Monitor(
-            training_env(self.config, self.atlas_file),
+            training_env(self.config, self.atlas_files),
             filename=None if self.monitor is None else str(self.monitor),
             info_keywords=("stop_error_m", "success"),
             override_existing=not self.append,
@@ -305,9 +357,10 @@ def train(
 
     Writes to ``out_dir``: ``model.zip`` (the final policy), ``config.json``,
     ``train_log.json`` (every training episode), ``learning_curve.png``, ``atlas.npz``
-    (the place, learned once), ``monitor/<i>.monitor.csv`` (SB3's per-worker episode
-    logs), with ``eval_freq`` ``eval/evaluations.npz`` and ``best/best_model.zip``
-    (held-out kidnappings), with ``save_freq`` ``checkpoints/model_<N>_steps.zip``.
+    (the place, learned once; ``atlas-place<s>.npz`` per place with ``places``),
+    ``monitor/<i>.monitor.csv`` (SB3's per-worker episode logs), with ``eval_freq``
+    ``eval/evaluations.npz`` and ``best/best_model.zip`` (held-out kidnappings), with
+    ``save_freq`` ``checkpoints/model_<N>_steps.zip``.
 
     Parameters
     ----------
@@ -356,13 +409,14 @@ def train(
     out = check_out_dir(out)
     write_json(out / "config.json", config.to_dict())
     t0 = time.perf_counter()
-    atlas_file = out / "atlas.npz"
+    atlas_files = config.atlas_files(out)
     if progress:
-        print(f"learning the place once ({config.scene}, seed {config.seed}) -> {atlas_file}")
-    learn_place(config, atlas_file)
+        seeds = ", ".join(map(str, config.place_seeds))
+        print(f"learning each place once ({config.scene}, learning seeds {seeds}) -> {out}")
+    learn_places(config, atlas_files)
     (out / "monitor").mkdir(exist_ok=True)
     factories = [
-        _EnvFactory(config, i, atlas_file, out / "monitor" / str(i), append=resume)
+        _EnvFactory(config, i, atlas_files, out / "monitor" / str(i), append=resume)
         for i in range(config.n_envs)
     ]
     if config.vec_env == "subproc":
@@ -379,8 +433,8 @@ def train(
     callbacks: list[Any] = [log]
     eval_env = None
     if config.eval_freq:
-        # the training env (same place, same rules), kidnapped from held-out seeds
-        eval_env = DummyVecEnv([lambda: Monitor(training_env(config, atlas_file))])
+        # the training env (same places, same rules), kidnapped from held-out seeds
+        eval_env = DummyVecEnv([lambda: Monitor(training_env(config, atlas_files))])
         callbacks.append(
             HeldOutEvaluation(
                 eval_env,
