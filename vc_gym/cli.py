@@ -901,7 +901,7 @@ def build_parser() -> argparse.ArgumentParser:
         type=_str_list,
         metavar="MODE,...",
         help="orientation, environments: paper (one spot, default) and/or improved (the same "
-        "learning at every spot of a 1.5 m grid with exposure-normalised colours; heading "
+        "learning at every spot of a 1.0 m grid with exposure-normalised colours; heading "
         "from the best-fitting map), e.g. --modes paper,improved",
     )
     p.add_argument(

@@ -270,19 +270,24 @@ def test_orientation_in_both_modes(tmp_path, capsys):
     assert set(r["modes"]) == {"paper", "improved"} and "scenes" not in r
     paper, improved = (r["modes"][m]["scenes"]["robolab"] for m in ("paper", "improved"))
     assert paper["training_spot"] == [-1.5, 0.0]
-    assert len(improved["spots"]) == 12 and improved["spots"][0] == [-2.25, 0.0]
-    # distances are from the nearest of 12 spots 1.5 m apart: never beyond ~1.1 m
+    # the quick size's spots are 2 m apart (6 in robolab; the other sizes' 1 m, 24)
+    assert len(improved["spots"]) == 6 and improved["spots"][0] == [-2.0, -1.0]
+    # distances are from the nearest spot: never beyond ~1.4 m
     for row in improved["trackers"]["grid"]["by_distance"]:
         assert row["bin_end_m"] <= 1.5
     assert {"grid", "compass"} <= set(improved["trackers"])
     assert (out / "arrow_field_improved.png").is_file()
     assert (out / "error_vs_distance_improved.png").is_file()
     text = capsys.readouterr().out
-    assert "improved mode:" in text and "12 spots" in text
+    assert "improved mode:" in text and "6 spots" in text
 
 
 def test_the_improved_mode_gives_the_built_in_trackers_a_shortlist():
-    from vc_gym.experiments.studies.orientation import MODE_TRACKER_OPTIONS, mode_trackers
+    from vc_gym.experiments.studies.orientation import (
+        MODE_TRACKER_OPTIONS,
+        mode_trackers,
+        training_spots,
+    )
 
     trackers = {
         "grid": "grid",
@@ -291,6 +296,7 @@ def test_the_improved_mode_gives_the_built_in_trackers_a_shortlist():
         "user": "my_package.trackers:make",
     }
     assert mode_trackers(trackers, "paper") == trackers
+    assert len(training_spots((-3.0, 3.0, -2.0, 2.0), "improved")) == 24  # robolab's field
     improved = mode_trackers(trackers, "improved")
     options = MODE_TRACKER_OPTIONS["improved"]
     assert improved["grid"] == {"type": "grid", **options}

@@ -63,7 +63,7 @@ EXPERIMENTS: dict[str, Experiment] = {
             "5.1, fig. 4: learn one spot (centre of the rear field half), heading error and "
             "spread of every tracker over a grid of poses vs distance from the spot, and "
             "the arrow field of the estimates (--modes paper,improved: also maps on a "
-            "1.5 m grid of spots; --light: dimmer views)",
+            "1.0 m grid of spots; --light: dimmer views)",
         ),
         Experiment(
             "environments",

@@ -16,8 +16,8 @@ nearest the paper's), plus four shorter turns :data:`GRID_AROUND_M` around each 
 into its map, with exposure-normalised colour classes (so that it holds at half
 light), the trackers take the heading from the map that fits best (eq. 28), and
 distances are measured from the nearest spot; between full scorings the built-in
-trackers score only the three spots that fitted best (:data:`MODE_TRACKER_OPTIONS`), so
-a frame costs about three maps, not twelve. ``light`` dims the room for the views
+trackers score only the two spots that fitted best (:data:`MODE_TRACKER_OPTIONS`), so
+a frame costs about five maps, not two dozen. ``light`` dims the room for the views
 (the maps are learned at full light).
 
 :func:`view_job` and :func:`views_summary` are shared by the environments, parameter,
@@ -84,8 +84,10 @@ __all__ = [
 DEFAULT_TRACKERS = ("grid", "kalman", "particle")
 _BUILT_IN_TRACKERS = frozenset(DEFAULT_TRACKERS)
 
+# ``spots_m``: spacing of the improved mode's spots (GRID_SPACING_M unless given; the
+# tests' quick size learns a coarser grid, 6 spots in robolab, to stay quick)
 SIZES = {
-    "quick": {"spacing_m": 2.0, "headings": 1, "frames": 4, "learn_time_s": 0.5},
+    "quick": {"spacing_m": 2.0, "headings": 1, "frames": 4, "learn_time_s": 0.5, "spots_m": 2.0},
     "paper": {"spacing_m": 0.5, "headings": 2, "frames": 10, "learn_time_s": 5.0},
     "full": {"spacing_m": 0.33, "headings": 3, "frames": 15, "learn_time_s": 5.0},
 }
@@ -95,29 +97,35 @@ SIZES = {
 #: options of each mode (:class:`~vc_gym.compass.CompassConfig` fields).
 VIEW_MODES: dict[str, dict[str, Any]] = {"paper": {}, "improved": {"exposure": "mean"}}
 #: Options each mode gives the built-in trackers (grid, kalman, particle): the improved
-#: mode's atlas has a dozen spots, so between full scorings its trackers score only the
-#: three that fitted best (:class:`~vc_gym.localization.SpotShortlist`; chosen on seed 0,
-#: where it gave the same error as scoring every spot at half the cost).
+#: mode's atlas has two dozen spots in robolab, so its trackers score every spot every
+#: 8th frame and, in between, only the two that fitted best
+#: (:class:`~vc_gym.localization.SpotShortlist`; chosen on seed 0 of robolab: 5.3°, where
+#: the three best every 4th frame gave 5.1° at 1.3 times the cost).
 MODE_TRACKER_OPTIONS: dict[str, dict[str, Any]] = {
     "paper": {},
-    "improved": {"shortlist": 3, "rescore_every": 4},
+    "improved": {"shortlist": 2, "rescore_every": 8},
 }
-#: Spacing of the improved mode's grid of spots (metres) and its margin inside the field.
-GRID_SPACING_M = 1.5
+#: Spacing of the improved mode's grid of spots (metres) and its margin inside the field
+#: (1.0 m: 24 spots in robolab; 1.5 m, 12 spots, gave 6.2 ± 0.5° over seeds 0-2 against
+#: 5.1 ± 0.2°, README).
+GRID_SPACING_M = 1.0
 GRID_MARGIN_M = 0.5
 #: The improved mode's maps also learn four turns this far around each spot
 #: (:class:`~vc_gym.envs.learning.GridLearning`'s ``around_m``).
 GRID_AROUND_M = 0.5
 
 
-def training_spots(bounds: Sequence[float], mode: str = "paper") -> list[tuple[float, float]]:
-    """The spots a mode learns: the paper's one, or a grid with the one nearest it first."""
+def training_spots(
+    bounds: Sequence[float], mode: str = "paper", spacing_m: float = GRID_SPACING_M
+) -> list[tuple[float, float]]:
+    """The spots a mode learns: the paper's one, or a grid ``spacing_m`` apart with the
+    one nearest it first."""
     if mode not in VIEW_MODES:
         raise ValueError(f"mode must be one of {list(VIEW_MODES)}, got {mode!r}")
     centre = rear_half_centre(bounds)
     if mode == "paper":
         return [centre]
-    grid = field_grid(tuple(bounds), GRID_SPACING_M, margin_m=GRID_MARGIN_M)
+    grid = field_grid(tuple(bounds), spacing_m, margin_m=GRID_MARGIN_M)
     order = np.argsort(np.hypot(grid[:, 0] - centre[0], grid[:, 1] - centre[1]), kind="stable")
     return [(round(float(x), 4), round(float(y), 4)) for x, y in grid[order]]
 
@@ -375,7 +383,7 @@ def orientation_stage(
     spots) and the field bounds.
     """
     bounds = scene_field_bounds(scene)
-    spots = training_spots(bounds, mode)
+    spots = training_spots(bounds, mode, size.get("spots_m", GRID_SPACING_M))
     compass = {**VIEW_MODES[mode], **dict(compass or {})}
     if mode == "paper":
         spot: Any = spots[0]
