@@ -252,6 +252,8 @@ def test_bad_camera_is_rejected(room_pano, room_fc):
         ({"fast_threshold": 300}, "fast_threshold"),
         ({"patch_size": 3}, "patch_size"),
         ({"n_levels": 0}, "n_levels"),
+        ({"n_levels": 10**6}, "n_levels"),
+        ({"patch_size": 10**6}, "patch_size"),
         ({"scale_factor": 1.0}, "scale_factor"),
         ({"scale_factor": float("nan")}, "scale_factor"),
         ({"ratio": 1.5}, "ratio"),

@@ -27,6 +27,10 @@ __all__ = ["FeatureCompass", "keypoint_directions"]
 
 #: Bytes of an ORB descriptor.
 DESCRIPTOR_BYTES = 32
+# OpenCV allocates a pyramid per level and a border of the patch size: beyond these a
+# sensor file's parameters would ask it for gigabytes (10**6 levels: an allocation error)
+_MAX_LEVELS = 32
+_MAX_PATCH_SIZE = 255
 
 
 def keypoint_directions(
@@ -85,11 +89,12 @@ class FeatureCompass(BaselineCompass):
         FAST corner threshold (grey levels, 1-254). Low, so that the plain walls of the
         simulator's 208 x 160 frames still give keypoints.
     patch_size : int
-        ORB patch size and border (pixels, >= 5): smaller keeps keypoints nearer the
+        ORB patch size and border (pixels, 5-255): smaller keeps keypoints nearer the
         edges of small frames.
     n_levels : int
-        Pyramid levels of the detector (a camera turning in place sees no change of
-        scale, so few are needed).
+        Pyramid levels of the detector, 1-32 (a camera turning in place sees no change
+        of scale, so few are needed). Both bounds keep a sensor file from asking
+        OpenCV for gigabytes.
     scale_factor : float
         Pyramid scale step, ``> 1``.
     ratio : float
@@ -196,7 +201,11 @@ class FeatureCompass(BaselineCompass):
         if self.fast_threshold > 254:
             raise ValueError(f"fast_threshold must be <= 254, got {fast_threshold}")
         self.patch_size = int_at_least("patch_size", patch_size, 5)
+        if self.patch_size > _MAX_PATCH_SIZE:
+            raise ValueError(f"patch_size must be <= {_MAX_PATCH_SIZE}, got {patch_size}")
         self.n_levels = int_at_least("n_levels", n_levels, 1)
+        if self.n_levels > _MAX_LEVELS:
+            raise ValueError(f"n_levels must be <= {_MAX_LEVELS}, got {n_levels}")
         self.scale_factor = positive_float("scale_factor", scale_factor)
         if not 1.0 < self.scale_factor <= 4.0:
             raise ValueError(f"scale_factor must be in (1, 4], got {scale_factor}")
