@@ -254,12 +254,16 @@ def test_config_validation():
         {"coverage": 0.0009},
         {"heading_step_deg": 0.7},
         {"heading_step_deg": 1e-9},  # divides 360, but 3.6e11 headings
+        {"sector_deg": 0.001, "n_colors": 32, "n_bins": 32},  # 1.2e10 counts
+        {"sector_deg": 0.5, "n_colors": 32, "n_bins": 32},  # 23.6 million counts
         {"smoothing": -1.0},
         {"temperature": 0.0},
         {"n_colors": 2.5},
     ):
         with pytest.raises(ValueError):
             CompassConfig(**bad)
+    # the largest map still allowed: 1° sectors, 32 classes, 32 bins
+    assert CompassConfig(sector_deg=1.0, n_colors=32, n_bins=32).n_sectors == 360
 
 
 # ------------------------------------------------------------------ persistence

@@ -7,12 +7,15 @@ from dataclasses import asdict, dataclass, fields
 
 from vc_gym.angles import MIN_HEADING_STEP_DEG
 
-__all__ = ["CompassConfig", "EXPOSURE_MODES", "MIN_COVERAGE"]
+__all__ = ["CompassConfig", "EXPOSURE_MODES", "MAX_MAP_ENTRIES", "MIN_COVERAGE"]
 
 #: Accepted values of :attr:`CompassConfig.exposure`.
 EXPOSURE_MODES = ("none", "mean")
 #: Smallest scanning coverage (0.1 %); the paper reports that < 1 % still works.
 MIN_COVERAGE = 0.001
+#: Most counts a map may hold (``n_sectors · n_colors² · n_bins``; 128 MB as float64).
+#: The paper's map holds 64,000; 1° sectors with 32 classes and 32 bins 11.8 million.
+MAX_MAP_ENTRIES = 2**24
 
 
 def _is_divisor_of_360(step: float) -> bool:
@@ -93,6 +96,14 @@ class CompassConfig:
             raise ValueError(f"sector_deg must be in (0, 90] and divide 360, got {self.sector_deg}")
         if not 2 <= self.n_bins <= 32:
             raise ValueError(f"n_bins must be in 2..32, got {self.n_bins}")
+        size = self.n_sectors * self.n_colors**2 * self.n_bins
+        if size > MAX_MAP_ENTRIES:
+            # a map file's config must not make the compass allocate gigabytes of counts
+            # (sector_deg=0.001 with 32 classes and bins: 1.2e10 entries)
+            raise ValueError(
+                f"the map would hold {size} counts (sectors x n_colors² x n_bins), more than "
+                f"{MAX_MAP_ENTRIES}: use wider sectors, fewer colour classes or bins"
+            )
         if not MIN_COVERAGE <= self.coverage <= 1:
             # below it the grid's steps exceed a small image: it would learn nothing
             raise ValueError(f"coverage must be in [{MIN_COVERAGE}, 1], got {self.coverage}")

@@ -144,6 +144,10 @@ def _bad_input_cases() -> list[Case]:
         "CompassConfig(coverage=1e-9)": lambda: CompassConfig(coverage=1e-9),
         "CompassConfig(n_colors=0)": lambda: CompassConfig(n_colors=0),
         "CompassConfig(sector_deg=7)": lambda: CompassConfig(sector_deg=7.0),
+        "CompassConfig(sector_deg=0.001, 32 classes, 32 bins)": lambda: CompassConfig(
+            sector_deg=0.001, n_colors=32, n_bins=32
+        ),
+        "TrainConfig(places=(1, 1))": lambda: TrainConfig(places=(1, 1)),
         "float image": lambda: vc().log_likelihood(image.astype(np.float32), Camera()),
         "grey image": lambda: vc().log_likelihood(image[:, :, 0], Camera()),
         "channels first": lambda: vc().log_likelihood(np.zeros((3, 160, 208), np.uint8), Camera()),
