@@ -778,8 +778,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="self-test: bad input, hostile files, faults and a short soak (< 5 min)",
         description=(
             "Run vc_gym's robustness cases: bad arguments and images, hostile map, model and "
-            "settings files (zip bombs, pickled payloads, bit flips, deep nesting), faults "
-            "(killed workers, a lost physics server, a rerun of a finished run), then a short "
+            "settings files (zip bombs, pickled payloads, bit flips, deep nesting), the same "
+            "misuse of every registered env (bad actions, resets, seeds, use after close), "
+            "faults (killed workers, a lost physics server, a rerun of a finished run), then "
+            "a short "
             "soak. Prints cases tried, passed and failed (0 expected) and the soak figures; "
             "the exit status is 1 if a case failed."
         ),

@@ -180,6 +180,10 @@ def test_close_is_idempotent_and_closed_env_refuses():
         env.unwrapped.step(np.zeros(5, np.float32))
     with pytest.raises(RuntimeError, match="closed"):
         env.unwrapped.reset()
+    # what wrappers reach for (the robot, the scene) says closed too, not "reset first"
+    for reach in (lambda: env.unwrapped.robot, lambda: env.unwrapped.scene):
+        with pytest.raises(RuntimeError, match="closed"):
+            reach()
 
 
 def test_repeated_make_close_does_not_leak_clients():

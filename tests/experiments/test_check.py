@@ -13,10 +13,20 @@ def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
     code = main(["check", "--soak-steps", "40", "--soak-cycles", "10", "--out", str(out)])
     r = json.loads(out.read_text())
     assert code == 0, r["failures"]
-    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 70
-    assert set(r["suites"]) == {"bad_input", "hostile_file", "sensors", "fault"}
+    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 110
+    assert set(r["suites"]) == {"bad_input", "hostile_file", "sensors", "envs", "fault"}
     assert r["soak"]["steps"] == 40 and r["soak"]["median_steps_per_s"] > 0
     assert "failed 0" in capsys.readouterr().out
+
+
+def test_the_env_suite_covers_every_registered_env():
+    import gymnasium as gym
+
+    names = [c.name for c in all_cases() if c.suite == "envs"]
+    for env_id in (k for k in gym.registry if k.startswith("vc_gym/")):
+        mine = [n for n in names if n.startswith(env_id + ":")]
+        assert len(mine) == 13 and mine[0].endswith("step before reset")
+        assert mine[-1].endswith("after close")
 
 
 def test_a_case_that_escapes_is_reported():

@@ -191,6 +191,7 @@ class AiboRoomEnv(gym.Env):
     @property
     def robot(self) -> Quadruped:
         """The robot (after :meth:`reset`)."""
+        self._check_open()  # after close: say so, not "reset first"
         if self._robot is None:
             raise RuntimeError("call reset() first")
         return self._robot
@@ -198,6 +199,7 @@ class AiboRoomEnv(gym.Env):
     @property
     def scene(self) -> Scene:
         """The current scene (after :meth:`reset`)."""
+        self._check_open()  # after close: say so, not "reset first"
         if self._scene is None:
             raise RuntimeError("call reset() first")
         return self._scene

@@ -5,7 +5,9 @@ checks that vc_gym answers with the right result or a clear error of the promise
 (``ValueError`` for bad arguments, :class:`~vc_gym.errors.MapFileError` for a file that
 cannot be read, ``RuntimeError`` for a closed env or a lost physics server), that a
 hostile file never runs code or exhausts memory, and that a dead worker ends or retries
-its job within seconds. A case fails if anything else happens: another exception, no
+its job within seconds. The env suite does the same misuse to every registered
+``vc_gym/`` env (a new env is covered without a new case). A case fails if anything
+else happens: another exception, no
 exception, a hang (each case has a time limit), or code from a file running. The soak
 suite reports the speed and memory figures of a short :func:`~vc_gym.experiments.soak.soak`.
 """
@@ -61,15 +63,20 @@ class Case:
     run: Callable[[Path], None]
 
 
-def _raises(kind: type[BaseException], match: str, fn: Callable[[], object]) -> None:
-    """``fn()`` must raise ``kind`` whose message contains ``match``."""
+def _raises(
+    kind: type[BaseException] | tuple[type[BaseException], ...],
+    match: str,
+    fn: Callable[[], object],
+) -> None:
+    """``fn()`` must raise ``kind`` (or one of them) whose message contains ``match``."""
     try:
         fn()
     except kind as exc:
         if match.lower() not in str(exc).lower():
-            raise AssertionError(f"{kind.__name__} without {match!r}: {exc}") from None
+            raise AssertionError(f"{type(exc).__name__} without {match!r}: {exc}") from None
         return
-    raise AssertionError(f"no {kind.__name__} raised")
+    names = [k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,))]
+    raise AssertionError(f"no {' or '.join(names)} raised")
 
 
 # --------------------------------------------------------------------------- bad input
@@ -525,9 +532,127 @@ def _fault_cases() -> list[Case]:
     ]
 
 
+# --------------------------------------------------------------------------- every env
+#: Small settings for the registered envs whose first reset runs a learning phase.
+_ENV_KWARGS: dict[str, dict[str, Any]] = {
+    "vc_gym/LearnThenHome-v0": {"learn_time_s": 0.2},
+    "vc_gym/Homing-v0": {"learn_time_s": 0.2},
+}
+
+
+class _SharedEnv:
+    """One env of a registered id for all of its cases (made on first use): its first
+    case steps it before any reset, its last one closes it."""
+
+    def __init__(self, env_id: str):
+        self.env_id = env_id
+        self._env: gym.Env | None = None
+
+    def get(self) -> gym.Env:
+        if self._env is None:
+            self._env = gym.make(self.env_id, **_ENV_KWARGS.get(self.env_id, {}))
+        return self._env
+
+    def reset(self) -> gym.Env:
+        env = self.get()
+        env.reset(seed=0)
+        return env
+
+    def close(self) -> gym.Env:
+        env = self.get()
+        env.close()
+        return env
+
+
+def _same_observation(a: Any, b: Any) -> bool:
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
+    return bool(np.array_equal(a, b))
+
+
+def _same_seed_same_start(shared: _SharedEnv) -> None:
+    env = shared.get()
+    first, _ = env.reset(seed=3)
+    again, _ = env.reset(seed=3)
+    assert _same_observation(first, again), "two resets with seed 3 differ"
+
+
+def _after_close(shared: _SharedEnv) -> None:
+    env = shared.close()
+    n = env.action_space.shape[0]
+    _raises(RuntimeError, "closed", lambda: env.step(np.zeros(n, np.float32)))
+    _raises(RuntimeError, "closed", lambda: env.reset(seed=0))
+    _raises(RuntimeError, "closed", env.render)
+
+
+def _bad_actions(n: int) -> dict[str, Any]:
+    """Actions every env must refuse with a ValueError (``n``: its action length)."""
+    return {
+        "NaN action": np.full(n, np.nan, np.float32),
+        "infinite action": np.full(n, np.inf, np.float32),
+        "action too short": np.zeros(n - 1, np.float32),
+        "action too long": np.zeros(n + 1, np.float32),
+        "2-D action": np.zeros((1, n), np.float32),
+        "text action": "forward",
+        "None action": None,
+    }
+
+
+def _step_before_reset(shared: _SharedEnv) -> None:
+    env = shared.get()
+    action = np.zeros(env.action_space.shape, np.float32)
+    _raises(gym.error.ResetNeeded, "reset", lambda: env.step(action))
+
+
+def _bad_action(shared: _SharedEnv, name: str) -> None:
+    env = shared.reset()
+    action = _bad_actions(int(env.action_space.shape[0]))[name]
+    _raises(ValueError, "", lambda: env.step(action))
+
+
+def _env_cases() -> list[Case]:
+    """The same misuse of every registered ``vc_gym/`` env (Minigrid-style: a new env
+    is covered without a new case)."""
+    cases = []
+    for env_id in sorted(k for k in gym.registry if k.startswith("vc_gym/")):
+        shared = _SharedEnv(env_id)
+
+        def case(name: str, fn: Callable[[], None], env_id: str = env_id) -> Case:
+            return Case("envs", f"{env_id}: {name}", lambda _, fn=fn: fn())
+
+        cases.append(case("step before reset", lambda s=shared: _step_before_reset(s)))
+        for name in _bad_actions(1):
+            cases.append(case(name, lambda s=shared, name=name: _bad_action(s, name)))
+        resets = {
+            "unknown reset option": {"options": {"nope": 1}},
+            "NaN reset pose": {"options": {"pose": (np.nan, 0.0, 0.0)}},
+            "negative seed": {"seed": -1},
+        }
+        for name, kwargs in resets.items():
+            cases.append(
+                case(
+                    name,
+                    lambda s=shared, kw=kwargs: _raises(
+                        (ValueError, gym.error.Error), "", lambda: s.get().reset(**kw)
+                    ),
+                )
+            )
+        cases.append(
+            case("same seed, same first observation", lambda s=shared: _same_seed_same_start(s))
+        )
+        cases.append(case("step, reset and render after close", lambda s=shared: _after_close(s)))
+    return cases
+
+
 def all_cases() -> list[Case]:
     """Every case of every suite (built on demand: some import heavy modules)."""
-    return [*_bad_input_cases(), *_hostile_file_cases(), *_sensor_cases(), *_fault_cases()]
+    return [
+        *_bad_input_cases(),
+        *_hostile_file_cases(),
+        *_sensor_cases(),
+        *_env_cases(),
+        *_fault_cases(),
+    ]
 
 
 def run_check(
