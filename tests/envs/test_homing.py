@@ -94,3 +94,30 @@ def test_only_the_stop_output_ends_an_episode(walk):
         _, _, terminated, truncated, info = env.step(np.array(walk, np.float32))
         assert not terminated and not truncated and info["still_time_s"] == 0.0
     env.close()
+
+
+def test_a_confirmed_stop_is_called_off_when_the_estimate_leaves_home():
+    env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=1.0, confirm_stop_m=0.25)
+    stop_wrapper = env
+    while not isinstance(stop_wrapper, StopAction):
+        stop_wrapper = stop_wrapper.env
+    stop_wrapper.min_walk_steps = 0
+    stop = np.array([0.0, 0.0, 1.0], np.float32)
+    # at home the estimate stays there: the stop holds and ends the episode
+    env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
+    _, _, terminated, _, info = env.step(stop)
+    assert terminated and info["success"] and info["still_time_s"] == pytest.approx(1.0)
+    # 1.5 m away the estimated home is far: the stop is called off after one standing
+    # step and the policy decides again
+    env.reset(seed=0, options={"pose": (1.5, 0.0, 0.0)})
+    obs, _, terminated, truncated, info = env.step(stop)
+    assert not terminated and not truncated
+    assert np.hypot(*obs[HomingFeatures.HOME_VECTOR]) * HomingFeatures.METRES_SCALE > 0.25
+    assert info["still_time_s"] == pytest.approx(0.1)
+    env.close()
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan")])
+def test_confirm_stop_must_be_a_positive_distance(bad):
+    with pytest.raises(ValueError, match="confirm_stop_m"):
+        gym.make("vc_gym/Homing-v0", learn_time_s=0.2, confirm_stop_m=bad)

@@ -86,6 +86,11 @@ class StopAction(gym.Wrapper):
     policy whose walk outputs hover near zero would stand still for the task's
     ``stop_time_s`` and end the episode by accident (11 % of early PPO episodes ended so
     within three decisions).
+
+    With ``confirm_stop_m`` a stop is checked while the robot stands, as the scripted
+    agent checks its own: if the estimated home (the features' home vector) moves
+    farther than that during the hold, the stop is called off and the step returns, not
+    ended, so that the policy decides again. ``None`` (default): a stop is final.
     """
 
     def __init__(
@@ -94,6 +99,7 @@ class StopAction(gym.Wrapper):
         max_forward: float = 0.4,
         max_turn_deg_s: float = 60.0,
         min_walk_s: float = 2.0,
+        confirm_stop_m: float | None = None,
     ):
         super().__init__(env)
         inner = env.action_space
@@ -107,6 +113,14 @@ class StopAction(gym.Wrapper):
         self.max_forward = positive_float("max_forward", max_forward)
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
         nonnegative_float("min_walk_s", min_walk_s)
+        if confirm_stop_m is not None:
+            positive_float("confirm_stop_m", confirm_stop_m)
+            space = env.observation_space
+            if not isinstance(space, spaces.Box) or space.shape[0] <= HomingFeatures.SPREAD:
+                raise ValueError(
+                    f"confirm_stop_m reads HomingFeatures' home vector; got observations {space}"
+                )
+        self.confirm_stop_m = confirm_stop_m
         self._pans = HEAD_SCAN_DEG
         self._n = inner.shape[0]
         self.action_space = spaces.Box(-1.0, 1.0, (3,), np.float32)
@@ -148,9 +162,17 @@ class StopAction(gym.Wrapper):
             pan = self._pans[i % len(self._pans)]
             obs, r, terminated, truncated, info = self.env.step(self._inner_action(0.0, 0.0, pan))
             total += float(r)
-            if terminated or truncated:
+            if terminated or truncated or self._left_home(obs):
                 break
         return obs, total, terminated, truncated, info
+
+    def _left_home(self, obs: np.ndarray) -> bool:
+        """With ``confirm_stop_m``: the estimated home is farther than that (the stop is
+        called off and the policy decides again)."""
+        if self.confirm_stop_m is None:
+            return False
+        home = np.asarray(obs[HomingFeatures.HOME_VECTOR], np.float64) * HomingFeatures.METRES_SCALE
+        return bool(np.hypot(*home) > self.confirm_stop_m)
 
 
 def make_homing_env(
@@ -158,6 +180,7 @@ def make_homing_env(
     max_forward: float = 0.4,
     max_turn_deg_s: float = 60.0,
     min_walk_s: float = 2.0,
+    confirm_stop_m: float | None = None,
     **task_kwargs: Any,
 ) -> gym.Env:
     """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
@@ -168,6 +191,8 @@ def make_homing_env(
         The tracker of the :class:`~vc_gym.envs.CompassObservation` wrapper.
     max_forward, max_turn_deg_s, min_walk_s : float
         :class:`StopAction` settings.
+    confirm_stop_m : float, optional
+        :class:`StopAction`'s check of a stop while the robot stands.
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
@@ -175,4 +200,4 @@ def make_homing_env(
     env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
     env = CompassObservation(env, keep_image=False, tracker=tracker)
     env = HomingFeatures(env)
-    return StopAction(env, max_forward, max_turn_deg_s, min_walk_s)
+    return StopAction(env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m)
