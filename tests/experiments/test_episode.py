@@ -70,3 +70,16 @@ def test_modes_choose_the_learning_and_the_policy():
         assert run.env.unwrapped.learn_config.normalise_at == "start"
     finally:
         run.close()
+
+
+def test_a_learned_agent_runs_with_its_stops_checked():
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+    from vc_gym.envs.homing import StopAction
+    from vc_gym.experiments.episode import LEARNED_CONFIRM_STOP_M
+
+    run = make_homing_run(agent=str(PRETRAINED_MODEL), learn_time_s=0.2, max_homing_s=3.0)
+    wrapper = run.env
+    while not isinstance(wrapper, StopAction):
+        wrapper = wrapper.env
+    assert wrapper.confirm_stop_m == LEARNED_CONFIRM_STOP_M == 0.25
+    run.env.close()
