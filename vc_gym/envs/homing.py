@@ -88,9 +88,11 @@ class StopAction(gym.Wrapper):
     within three decisions).
 
     With ``confirm_stop_m`` a stop is checked while the robot stands, as the scripted
-    agent checks its own: if the estimated home (the features' home vector) moves
-    farther than that during the hold, the stop is called off and the step returns, not
-    ended, so that the policy decides again. ``None`` (default): a stop is final.
+    agent checks its own: if at any step of the hold the estimated home (the features'
+    home vector) is farther than that, the stop is called off and the step returns, not
+    ended, so that the policy decides again. An episode can then end by a stop only
+    where the estimate stays within ``confirm_stop_m`` of home for the task's
+    ``stop_time_s``. ``None`` (default): a stop is final.
     """
 
     def __init__(
