@@ -26,8 +26,8 @@ from vc_gym.validation import int_at_least
 __all__ = ["bench_train"]
 
 
-def _env_rate(config: TrainConfig, atlas_file: Path, steps: int, seed: int) -> float:
-    env = training_env(config, atlas_file)
+def _env_rate(config: TrainConfig, run_dir: Path, steps: int, seed: int) -> float:
+    env = training_env(config, run_dir)
     rng = np.random.default_rng(seed)
     try:
         env.reset(seed=seed)
@@ -76,11 +76,11 @@ def bench_train(
         timesteps=timesteps, n_envs=n_envs, seed=seed, learn_time_s=learn_time_s, demo_episodes=0
     )
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
-        atlas_file = Path(tmp) / "atlas.npz"
-        learn_places(config, atlas_file)
-        before = _env_rate(config, atlas_file, env_steps, seed)
+        # the place is learned once into the run folder, where train() finds it
+        learn_places(config, tmp)
+        before = _env_rate(config, Path(tmp), env_steps, seed)
         run = train(config, tmp, progress=progress)
-        after = _env_rate(config, atlas_file, env_steps, seed + 1)
+        after = _env_rate(config, Path(tmp), env_steps, seed + 1)
     env_rate = float(np.median([before, after]))
     train_rate = float(run["decisions_per_s"])
     return {

@@ -7,9 +7,9 @@ cannot be read, ``RuntimeError`` for a closed env or a lost physics server), tha
 hostile file never runs code or exhausts memory, and that a dead worker ends or retries
 its job within seconds. The env suite does the same misuse to every registered
 ``vc_gym/`` env (a new env is covered without a new case). A case fails if anything
-else happens: another exception, no
-exception, a hang (each case has a time limit), or code from a file running. The soak
-suite reports the speed and memory figures of a short :func:`~vc_gym.experiments.soak.soak`.
+else happens: another exception, no exception, a hang (each case has a time limit), or
+code from a file running. The soak suite reports the speed and memory figures of a
+short :func:`~vc_gym.experiments.soak.soak`.
 """
 
 from __future__ import annotations
@@ -81,9 +81,15 @@ def _raises(
 
 # --------------------------------------------------------------------------- bad input
 @functools.cache
+def _panorama() -> np.ndarray:
+    """The synthetic room panorama the compass and the baselines learn (made once)."""
+    return make_panorama(np.random.default_rng(7), width=1200, height=300, kind="room")
+
+
+@functools.cache
 def _learned() -> VisualCompass:
-    """A compass learned on a synthetic room panorama (built once per process)."""
-    pano = make_panorama(np.random.default_rng(7), width=1200, height=300, kind="room")
+    """A compass learned on the synthetic room panorama (built once per process)."""
+    pano = _panorama()
     vc = VisualCompass()
     vc.fit_colors([render_view(pano, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
     for a in range(0, 360, 15):
@@ -371,7 +377,7 @@ _IMAGE_BASELINES = ("image_difference", "sector_colour", "feature")
 @functools.cache
 def _learned_baseline(name: str) -> Any:
     """A baseline learned on the synthetic room panorama (built once per process)."""
-    pano = make_panorama(np.random.default_rng(7), width=1200, height=300, kind="room")
+    pano = _panorama()
     sensor = make_sensor(name)
     for a in range(0, 360, 30):
         sensor.learn(render_view(pano, Camera(yaw_deg=a)), Camera(yaw_deg=a))

@@ -13,7 +13,6 @@ import json
 import os
 import time
 import warnings
-from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
@@ -241,22 +240,25 @@ class TrainConfig:
         return config
 
 
-def training_env(
-    config: TrainConfig, atlas_files: str | os.PathLike | Sequence[str | os.PathLike]
-) -> gym.Env:
-    """``vc_gym/Homing-v0`` as ``config`` trains on it: one env per place
-    (:attr:`TrainConfig.place_seeds`), each loading its place, learned once, from its
-    entry of ``atlas_files`` (the first env that needs a place learns it); several
-    places make a :class:`~vc_gym.envs.PlacePool`."""
-    if isinstance(atlas_files, (str, os.PathLike)):
-        atlas_files = [atlas_files]
-    seeds = config.place_seeds
-    if len(atlas_files) != len(seeds):
-        raise ValueError(f"need one atlas file per place {seeds}, got {len(atlas_files)}")
-    envs = [
-        gym.make("vc_gym/Homing-v0", **config.env_kwargs(), atlas_file=str(f), learning_seed=seed)
-        for seed, f in zip(seeds, atlas_files, strict=True)
-    ]
+def _place_env(config: TrainConfig, seed: int, atlas_file: Path) -> gym.Env:
+    """``vc_gym/Homing-v0`` of one place: learning seed ``seed``, its atlas learned once
+    into ``atlas_file`` by the first env that needs it and loaded by every other."""
+    return gym.make(
+        "vc_gym/Homing-v0", **config.env_kwargs(), atlas_file=str(atlas_file), learning_seed=seed
+    )
+
+
+def _places(config: TrainConfig, out_dir: str | os.PathLike) -> list[tuple[int, Path]]:
+    """``(learning seed, atlas file)`` of every place of the run in ``out_dir``."""
+    return list(zip(config.place_seeds, config.atlas_files(out_dir), strict=True))
+
+
+def training_env(config: TrainConfig, out_dir: str | os.PathLike) -> gym.Env:
+    """``vc_gym/Homing-v0`` as ``config`` trains on it in the run folder ``out_dir``: one
+    env per place (:attr:`TrainConfig.place_seeds`, atlases in
+    :meth:`TrainConfig.atlas_files`); several places make a
+    :class:`~vc_gym.envs.PlacePool`."""
+    envs = [_place_env(config, seed, f) for seed, f in _places(config, out_dir)]
     return envs[0] if len(envs) == 1 else PlacePool(envs)
 
 
@@ -266,17 +268,13 @@ def check_names(config: TrainConfig) -> None:
     make_tracker(config.tracker)
 
 
-def learn_places(
-    config: TrainConfig, atlas_files: str | os.PathLike | Sequence[str | os.PathLike]
-) -> int:
-    """Run the learning phase of each of ``config``'s places once, into its entry of
-    ``atlas_files`` (kept if it is there already and was learned the same way). Returns
-    how many places were learned now."""
-    if isinstance(atlas_files, (str, os.PathLike)):
-        atlas_files = [atlas_files]
+def learn_places(config: TrainConfig, out_dir: str | os.PathLike) -> int:
+    """Run the learning phase of each of ``config``'s places once, into its atlas file in
+    the run folder ``out_dir`` (kept if it is there already and was learned the same
+    way). Returns how many places were learned now."""
     learned = 0
-    for seed, f in zip(config.place_seeds, atlas_files, strict=True):
-        env = training_env(replace(config, places=(), seed=seed), f)
+    for seed, f in _places(config, out_dir):
+        env = _place_env(config, seed, f)
         try:
             env.reset(seed=seed)
             learned += bool(env.unwrapped.learner.learned)
@@ -310,18 +308,18 @@ class _EnvFactory:
         self,
         config: TrainConfig,
         rank: int,
-        atlas_files: Sequence[Path],
+        out_dir: Path,
         monitor: str | os.PathLike | None = None,
         append: bool = False,
     ):
-        self.config, self.rank, self.atlas_files = config, rank, atlas_files
+        self.config, self.rank, self.out_dir = config, rank, out_dir
         self.monitor, self.append = monitor, append
 
     def __call__(self) -> gym.Env:
         from stable_baselines3.common.monitor import Monitor
 
         env = Monitor(
-            training_env(self.config, self.atlas_files),
+            training_env(self.config, self.out_dir),
             filename=None if self.monitor is None else str(self.monitor),
             info_keywords=("stop_error_m", "success"),
             override_existing=not self.append,
@@ -409,14 +407,13 @@ def train(
     out = check_out_dir(out)
     write_json(out / "config.json", config.to_dict())
     t0 = time.perf_counter()
-    atlas_files = config.atlas_files(out)
     if progress:
         seeds = ", ".join(map(str, config.place_seeds))
         print(f"learning each place once ({config.scene}, learning seeds {seeds}) -> {out}")
-    learn_places(config, atlas_files)
+    learn_places(config, out)
     (out / "monitor").mkdir(exist_ok=True)
     factories = [
-        _EnvFactory(config, i, atlas_files, out / "monitor" / str(i), append=resume)
+        _EnvFactory(config, i, out, out / "monitor" / str(i), append=resume)
         for i in range(config.n_envs)
     ]
     if config.vec_env == "subproc":
@@ -434,7 +431,7 @@ def train(
     eval_env = None
     if config.eval_freq:
         # the training env (same places, same rules), kidnapped from held-out seeds
-        eval_env = DummyVecEnv([lambda: Monitor(training_env(config, atlas_files))])
+        eval_env = DummyVecEnv([lambda: Monitor(training_env(config, out))])
         callbacks.append(
             HeldOutEvaluation(
                 eval_env,
