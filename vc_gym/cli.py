@@ -421,7 +421,9 @@ def _cmd_soak(args: argparse.Namespace) -> int:
     print(
         f"{r['cycles']} make/close cycles: {r['rss_before_cycles_mb']} -> "
         f"{r['rss_after_cycles_mb']} MB, growth {r['rss_growth_kb_per_cycle']} KB per cycle "
-        f"({verdict} the {r['growth_target_kb_per_cycle']:g} KB target)"
+        f"({verdict} the {r['growth_target_kb_per_cycle']:g} KB target); C heap in use: "
+        f"{r['heap_growth_kb_per_10k_steps']} KB per 10k steps, "
+        f"{r['heap_growth_kb_per_cycle']} KB per cycle"
     )
     return 0
 
@@ -763,7 +765,9 @@ def build_parser() -> argparse.ArgumentParser:
             "Step one vc_gym/AiboRoom-v0 for --steps steps with random actions (windows of "
             "--window steps: steps/s and resident memory), then make, reset, step and close "
             "--cycles envs; print the memory growth per 10,000 steps and per make/close "
-            "cycle (target: within noise, <= 5 KB per cycle). Full run: about 15 min."
+            "cycle (target: within noise, <= 5 KB per cycle). Each memory sample is taken "
+            "after the C allocator has given its free memory back (glibc malloc_trim), and "
+            "the C heap in use (glibc mallinfo2) is printed too. Full run: about 15 min."
         ),
     )
     p.add_argument("--steps", type=int, default=50_000, help="steps of the long run")

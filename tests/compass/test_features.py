@@ -63,3 +63,19 @@ def test_scan_grid_offsets_follow_camera():
     assert g.offsets_deg[0] == pytest.approx(30.0, abs=0.5)
     assert g.offsets_deg[-1] == pytest.approx(-30.0, abs=0.5)
     assert np.all(np.diff(g.offsets_deg) < 0)
+
+
+def test_change_ratio_is_one_for_independent_pixels_and_small_for_regions():
+    from vc_gym.compass.features import NOISE_CHANGE_RATIO, change_ratio
+
+    rng = np.random.default_rng(0)
+    independent = rng.integers(0, 5, (60, 100))
+    assert change_ratio(independent, 5) == pytest.approx(1.0, abs=0.05)
+    skewed = rng.choice(3, size=(60, 100), p=[0.8, 0.15, 0.05])  # still independent
+    assert change_ratio(skewed, 3) == pytest.approx(1.0, abs=0.08)
+    bands = np.repeat(np.arange(6) % 3, 10)[:, None] * np.ones((1, 100), int)  # 6 bands
+    # 5 changes in 59 row pairs, against 2/3 for independent pixels
+    assert change_ratio(bands, 3) == pytest.approx((5 / 59) / (2 / 3))
+    assert change_ratio(bands, 3) < NOISE_CHANGE_RATIO <= change_ratio(independent, 5) + 0.1
+    assert change_ratio(np.zeros((10, 10), int), 3) == 0.0  # one class
+    assert change_ratio(np.zeros((1, 10), int), 3) == 0.0  # one row

@@ -93,7 +93,7 @@ def test_sector_counts_are_the_columns_summed_by_sector(room_pano, room_compass,
     that sector (the counts behind eq. 11, per sector)."""
     image = render_view(room_pano, camera.replace(yaw_deg=33.0))
     geom, counts, total = room_compass._sector_features(image, camera)
-    colcounts = room_compass._column_counts(image, geom)
+    colcounts = room_compass._column_counts(room_compass._scanned_classes(image, geom))
     delta = room_compass.config.sector_deg
     headings = room_compass._headings
     phases = np.unique(np.round(headings - np.floor(headings / delta + 1e-9) * delta, 9))
@@ -401,3 +401,30 @@ def test_a_frame_without_colour_changes_gives_a_flat_likelihood(room_pano, room_
     assert est.n_sectors == 0 and est.spread_deg > 90.0
     true = room_compass.estimate(render_view(room_pano, Camera(yaw_deg=40.0)), Camera())
     assert true.n_sectors > 0 and abs(wrap180(true.heading_deg - 40.0)) < 3.0
+
+
+def _noise(kind: str, rng: np.random.Generator) -> np.ndarray:
+    if kind == "uniform":
+        return rng.integers(0, 256, (160, 208, 3), dtype=np.uint8)
+    if kind == "grey":
+        return np.repeat(rng.integers(0, 256, (160, 208, 1), dtype=np.uint8), 3, axis=2)
+    small = rng.integers(0, 256, (80, 104, 3), dtype=np.uint8)  # 2-pixel blocks
+    return np.repeat(np.repeat(small, 2, axis=0), 2, axis=1)
+
+
+@pytest.mark.parametrize("kind", ["uniform", "grey", "blocks2"])
+def test_a_frame_of_noise_gives_a_flat_likelihood(room_pano, room_compass, kind):
+    # uniform noise used to get a confident (1.9° spread) and arbitrary heading
+    frame = _noise(kind, np.random.default_rng(3))
+    assert np.all(room_compass.log_likelihood(frame, Camera()) == 0.0)
+    est = room_compass.estimate(frame, Camera())
+    assert est.n_sectors == 0 and est.spread_deg > 90.0
+
+
+def test_a_noisy_camera_frame_still_gives_its_heading(room_pano, room_compass):
+    """Sensor noise on a real view is not mistaken for a frame of noise."""
+    rng = np.random.default_rng(4)
+    view = render_view(room_pano, Camera(yaw_deg=75.0)).astype(np.float64)
+    noisy = np.clip(view + rng.normal(0.0, 8.0, view.shape), 0, 255).astype(np.uint8)
+    est = room_compass.estimate(noisy, Camera())
+    assert est.n_sectors > 0 and abs(wrap180(est.heading_deg - 75.0)) < 5.0

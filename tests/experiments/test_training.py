@@ -190,6 +190,8 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
         {"learning_rate": float("nan")},
         {"demo_episodes": -1},
         {"algo": "sac", "demo_episodes": 5},
+        {"confirm_stop_m": 0.0},
+        {"confirm_stop_m": float("inf")},
     ],
 )
 def test_bad_train_config(kwargs):
@@ -218,6 +220,15 @@ def test_config_file_round_trip_and_errors(tmp_path):
         TrainConfig.from_dict({**TINY.to_dict(), "env": {"scene": "office"}})
     schema1 = {k: v for k, v in TINY.to_dict().items() if k not in ("env", "tracker")}
     assert TrainConfig.from_dict({**schema1, "schema": 1}) == TINY
+
+
+def test_a_checked_stop_in_training_reaches_the_env_and_old_configs_still_load():
+    checked = replace(TINY, confirm_stop_m=0.25, stop_time_s=5.0)
+    assert checked.env_kwargs()["confirm_stop_m"] == 0.25
+    assert TrainConfig.from_dict(checked.to_dict()) == checked
+    assert "confirm_stop_m" not in TINY.env_kwargs()  # configs saved before it existed
+    saved_before = {k: v for k, v in TINY.to_dict().items() if k != "confirm_stop_m"}
+    assert TrainConfig.from_dict(saved_before) == TINY
 
 
 def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):

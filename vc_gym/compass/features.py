@@ -16,7 +16,21 @@ import numpy as np
 
 from vc_gym.compass.camera import Camera
 
-__all__ = ["log2_bin", "ScanGrid", "scan_grid", "column_transition_counts"]
+__all__ = [
+    "NOISE_CHANGE_RATIO",
+    "log2_bin",
+    "ScanGrid",
+    "scan_grid",
+    "column_transition_counts",
+    "change_ratio",
+]
+
+#: A frame whose vertical class changes are at least this frequent, relative to
+#: independent pixels with the same class frequencies (:func:`change_ratio`), has no
+#: spatial structure: the frame is noise (snow, a broken feed) and says nothing about
+#: the heading. Measured: camera frames of every simulated scene 0.09-0.75, the real
+#: rotation crops (3 and 10 classes) up to 0.78 (grass); uniform noise 0.98-1.03.
+NOISE_CHANGE_RATIO = 0.9
 
 
 def log2_bin(z: np.ndarray, n_bins: int) -> np.ndarray:
@@ -127,3 +141,30 @@ def column_transition_counts(
     if not count_same_class:
         counts[:, :: n_colors + 1] = 0
     return counts.astype(np.float32)
+
+
+def change_ratio(classes: np.ndarray, n_colors: int) -> float:
+    """How often the class changes between vertical neighbours, relative to chance.
+
+    Parameters
+    ----------
+    classes : numpy.ndarray
+        ``(R, U)`` class ids of the scanned grid.
+    n_colors : int
+        Number of classes ``c``.
+
+    Returns
+    -------
+    float
+        ``q / e``: ``q`` is the fraction of vertical neighbour pairs whose classes
+        differ, ``e = 1 - Σ_k p_k²`` the fraction that would differ if the pixels were
+        drawn independently with the frame's class frequencies ``p_k``. Images of a
+        scene are made of regions and edges (well below 1); noise is near 1. 0 for a
+        frame of one class or fewer than two rows.
+    """
+    if classes.shape[0] < 2 or classes.size == 0:
+        return 0.0
+    q = float(np.count_nonzero(classes[1:] != classes[:-1])) / classes[1:].size
+    p = np.bincount(classes.ravel(), minlength=n_colors) / classes.size
+    e = 1.0 - float(np.dot(p, p))
+    return q / e if e > 1e-12 else 0.0

@@ -19,7 +19,14 @@ from vc_gym.angles import circular_std_rows, peak_headings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
-from vc_gym.compass.features import ScanGrid, column_transition_counts, log2_bin, scan_grid
+from vc_gym.compass.features import (
+    NOISE_CHANGE_RATIO,
+    ScanGrid,
+    change_ratio,
+    column_transition_counts,
+    log2_bin,
+    scan_grid,
+)
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.exposure import gain_table, mean_linear_level
 from vc_gym.images import check_image
@@ -321,12 +328,15 @@ class VisualCompass:
             return pixels
         return np.take(gain_table(ref / level), pixels)
 
-    def _column_counts(self, image: np.ndarray, geom: _Geometry) -> np.ndarray:
+    def _scanned_classes(self, image: np.ndarray, geom: _Geometry) -> np.ndarray:
+        """``(R, U)`` class ids of the scanned grid (after the exposure correction)."""
         assert self._colors is not None
         pixels = image[geom.row_slice, geom.col_slice]
         if self.config.exposure == "mean":
             pixels = self._apply_gain(pixels, mean_linear_level(pixels), self._exposure_ref)
-        classes = self._colors.classify_pixels(pixels)
+        return self._colors.classify_pixels(pixels)
+
+    def _column_counts(self, classes: np.ndarray) -> np.ndarray:
         return column_transition_counts(classes, self.config.n_colors, self.config.count_same_class)
 
     def _checked(self, image: np.ndarray, camera: Camera, need_map: bool) -> None:
@@ -359,7 +369,7 @@ class VisualCompass:
         self._checked(image, camera, need_map=False)
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
-        colcounts = self._column_counts(image, geom)
+        colcounts = self._column_counts(self._scanned_classes(image, geom))
         cfg = self.config
         sector = (
             np.floor((camera.yaw_deg + geom.grid.offsets_deg) / cfg.sector_deg + 1e-9).astype(
@@ -451,13 +461,19 @@ class VisualCompass:
         covered or overexposed frame, a blank wall) says nothing about the heading: it
         gives no counts at all, so it is treated like a frame that sees nothing above
         the horizon (a flat log-likelihood), not as a confident match of the maps'
-        "no change" statistics.
+        "no change" statistics. So does a frame of noise, whose classes change between
+        neighbours as often as those of independent pixels
+        (:data:`~vc_gym.compass.features.NOISE_CHANGE_RATIO`): its transitions are
+        chance, and matched against the maps they would still pick some heading
+        confidently.
         """
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
-        colcounts = self._column_counts(image, geom)
+        classes = self._scanned_classes(image, geom)
+        colcounts = self._column_counts(classes)
         c = self.config.n_colors
-        if not colcounts.reshape(-1, c, c).sum(axis=0)[~np.eye(c, dtype=bool)].any():
+        no_change = not colcounts.reshape(-1, c, c).sum(axis=0)[~np.eye(c, dtype=bool)].any()
+        if no_change or change_ratio(classes, c) >= NOISE_CHANGE_RATIO:
             colcounts = np.zeros_like(colcounts)
         # integer counts in float32: the cumulative sums and their differences are exact
         cum = np.zeros((colcounts.shape[0] + 1, colcounts.shape[1]), dtype=colcounts.dtype)

@@ -97,10 +97,18 @@ def _learned() -> VisualCompass:
     return vc
 
 
-def _flat_frame(_: Path) -> None:
-    frame = np.zeros((160, 208, 3), np.uint8)
-    ll = _learned().log_likelihood(frame, Camera())
-    assert np.all(ll == 0.0), "an all-black frame must give a flat likelihood"
+def _flat_frame(kind: str) -> Callable[[Path], None]:
+    """Case: a frame that shows nothing (all black) or only noise gives a flat likelihood."""
+
+    def run(_: Path) -> None:
+        if kind == "all-black":
+            frame = np.zeros((160, 208, 3), np.uint8)
+        else:
+            frame = np.random.default_rng(0).integers(0, 256, (160, 208, 3), dtype=np.uint8)
+        ll = _learned().log_likelihood(frame, Camera())
+        assert np.all(ll == 0.0), f"{kind} frame: the likelihood must be flat"
+
+    return run
 
 
 def _kalman_survives(_: Path) -> None:
@@ -180,7 +188,8 @@ def _bad_input_cases() -> list[Case]:
         for name, fn in simple.items()
     ]
     cases += [
-        Case("bad_input", "all-black frame: flat likelihood", _flat_frame),
+        Case("bad_input", "all-black frame: flat likelihood", _flat_frame("all-black")),
+        Case("bad_input", "uniform-noise frame: flat likelihood", _flat_frame("uniform-noise")),
         Case("bad_input", "Kalman: extreme inputs refused, filter still works", _kalman_survives),
         Case(
             "bad_input",

@@ -5,13 +5,23 @@
 process's resident memory (RSS); then it makes, resets, steps and closes ``cycles`` envs
 one after another and records the RSS again. The growth figures are least-squares slopes
 of RSS against steps and against cycles, measured after a warm-up (the first window, the
-first quarter of the cycles) in which the allocator's arenas and caches fill (RSS rises
-in steps of about 2 MB over the first few dozen envs, then stays flat): a leak shows as
-a slope well above that noise.
+first quarter of the cycles) in which the allocator's arenas and caches fill.
+
+Freed memory is not always given back to the system: glibc's allocator keeps it in its
+arenas, and an env's worth of freed blocks (a few MB) makes RSS jump up and down by
+whole megabytes between samples, which swamped the per-cycle slope (−8 to +69 KB per
+cycle in runs of the same code). Where glibc is the allocator, every sample is
+therefore taken after ``malloc_trim(0)``, which returns free memory and nothing that is
+still allocated (a leak stays in RSS), and the bytes the allocator has handed out and
+not taken back (``mallinfo2``: in-use blocks plus mmapped blocks) are reported too: the
+exact count of C-level memory a leak would grow. Python objects are checked separately
+(a test counts them with ``tracemalloc``).
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import gc
 import os
 import time
@@ -24,7 +34,7 @@ from tqdm import tqdm
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.validation import int_at_least
 
-__all__ = ["GROWTH_TARGET_KB", "rss_bytes", "soak"]
+__all__ = ["GROWTH_TARGET_KB", "heap_in_use_bytes", "release_free_memory", "rss_bytes", "soak"]
 
 ENV_ID = "vc_gym/AiboRoom-v0"
 #: Growth per make/close cycle that counts as "within noise" (KB).
@@ -40,10 +50,69 @@ def rss_bytes() -> int:
         return 0
 
 
-def _slope(x: list[float], y: list[float]) -> float | None:
-    if len(x) < 2 or len(set(x)) < 2:
+class _MallInfo2(ctypes.Structure):
+    _fields_ = [
+        (name, ctypes.c_size_t)
+        for name in (
+            "arena", "ordblks", "smblks", "hblks", "hblkhd",
+            "usmblks", "fsmblks", "uordblks", "fordblks", "keepcost",
+        )
+    ]  # fmt: skip
+
+
+def _load_glibc() -> ctypes.CDLL | None:
+    """The C library if it is glibc ≥ 2.33 (``mallinfo2`` and ``malloc_trim``), else None."""
+    name = ctypes.util.find_library("c")
+    try:
+        libc = ctypes.CDLL(name)
+        libc.mallinfo2.restype = _MallInfo2
+        libc.malloc_trim.argtypes = [ctypes.c_size_t]
+        libc.malloc_trim.restype = ctypes.c_int
+    except (OSError, AttributeError, TypeError):
+        return None
+    return libc
+
+
+_GLIBC = _load_glibc()
+
+
+def release_free_memory() -> bool:
+    """Collect Python garbage and give the allocator's free memory back to the system.
+
+    Returns whether the allocator could be asked (glibc's ``malloc_trim``); memory that
+    is still allocated is never released, so a leak still shows in :func:`rss_bytes`.
+    """
+    gc.collect()
+    if _GLIBC is None:
+        return False
+    _GLIBC.malloc_trim(0)
+    return True
+
+
+def heap_in_use_bytes() -> int | None:
+    """Bytes the C allocator has handed out and not taken back (glibc ``mallinfo2``:
+    in-use blocks of every arena plus mmapped blocks); None without glibc ≥ 2.33."""
+    if _GLIBC is None:
+        return None
+    info = _GLIBC.mallinfo2()
+    return int(info.uordblks + info.hblkhd)
+
+
+def _slope(x: list[float], y: list[float | None]) -> float | None:
+    if len(x) < 2 or len(set(x)) < 2 or any(v is None for v in y):
         return None
     return float(np.polyfit(np.asarray(x, float), np.asarray(y, float), 1)[0])
+
+
+def _kb(per: float | None, scale: float = 1.0, digits: int = 2) -> float | None:
+    return None if per is None else round(per * scale / 1024, digits)
+
+
+def _sample(rss: list[int], heap: list[int | None]) -> None:
+    """Append this moment's RSS and heap in use, after giving free memory back."""
+    release_free_memory()
+    rss.append(rss_bytes())
+    heap.append(heap_in_use_bytes())
 
 
 def soak(
@@ -76,8 +145,10 @@ def soak(
     dict
         ``steps_per_s`` per window, its median and first/last ratio, ``rss_mb`` per
         window, ``rss_growth_kb_per_10k_steps``, ``rss_growth_kb_per_cycle``, the RSS
-        before and after the cycles, and whether the cycle growth is within
-        :data:`GROWTH_TARGET_KB`.
+        before and after the cycles, whether the cycle growth is within
+        :data:`GROWTH_TARGET_KB`, the C heap's growth (``heap_growth_kb_per_10k_steps``,
+        ``heap_growth_kb_per_cycle``; None without glibc) and whether free memory was
+        given back before each sample (``free_memory_released``).
     """
     int_at_least("window", window, 10)
     int_at_least("steps", steps, 2 * window)
@@ -85,7 +156,10 @@ def soak(
     kwargs = dict(env_kwargs or {})
     rng = np.random.default_rng(seed)
     env = gym.make(ENV_ID, **kwargs)
-    rates, rss, at = [], [], []
+    rates: list[float] = []
+    rss: list[int] = []
+    heap: list[int | None] = []
+    at: list[int] = []
     try:
         env.reset(seed=seed)
         done = 0
@@ -100,13 +174,14 @@ def soak(
                         env.reset()
                 rates.append(n / (time.perf_counter() - t0))
                 done += n
-                gc.collect()
-                rss.append(rss_bytes())
+                _sample(rss, heap)
                 at.append(done)
                 bar.update(n)
     finally:
         env.close()
-    cycle_rss, cycle_at = [], []
+    cycle_rss: list[int] = []
+    cycle_heap: list[int | None] = []
+    cycle_at: list[int] = []
     warm = max(1, cycles // 4)
     for k in tqdm(range(cycles), desc="soak: make/close", disable=not progress):
         env = gym.make(ENV_ID, **kwargs)
@@ -116,11 +191,11 @@ def soak(
         finally:
             env.close()
         if k >= warm:
-            gc.collect()
-            cycle_rss.append(rss_bytes())
+            _sample(cycle_rss, cycle_heap)
             cycle_at.append(k)
     per_step = _slope(at[1:], rss[1:])
     per_cycle = _slope(cycle_at, cycle_rss)
+    heap_per_cycle = _slope(cycle_at, cycle_heap)
     return {
         "steps": steps,
         "cycles": cycles,
@@ -129,12 +204,13 @@ def soak(
         "median_steps_per_s": round(float(np.median(rates)), 1),
         "last_over_first_window": round(rates[-1] / rates[0], 3),
         "rss_mb": [round(r / 2**20, 1) for r in rss],
-        "rss_growth_kb_per_10k_steps": None
-        if per_step is None
-        else round(per_step * 1e4 / 1024, 1),
+        "rss_growth_kb_per_10k_steps": _kb(per_step, 1e4, 1),
+        "heap_growth_kb_per_10k_steps": _kb(_slope(at[1:], heap[1:]), 1e4, 1),
         "rss_before_cycles_mb": round(cycle_rss[0] / 2**20, 1) if cycle_rss else None,
         "rss_after_cycles_mb": round(cycle_rss[-1] / 2**20, 1) if cycle_rss else None,
-        "rss_growth_kb_per_cycle": None if per_cycle is None else round(per_cycle / 1024, 2),
+        "rss_growth_kb_per_cycle": _kb(per_cycle),
+        "heap_growth_kb_per_cycle": _kb(heap_per_cycle),
+        "free_memory_released": _GLIBC is not None,
         "growth_target_kb_per_cycle": GROWTH_TARGET_KB,
         "cycles_within_target": per_cycle is not None and per_cycle / 1024 <= GROWTH_TARGET_KB,
     }

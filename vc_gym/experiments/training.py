@@ -76,6 +76,12 @@ class TrainConfig:
         The robot does not move while it stands, so the outcome (where it stopped) and
         the rewards are those of the paper's 5 s; training just wastes fewer
         simulated seconds. Evaluation uses the task's 5 s.
+    confirm_stop_m : float, optional
+        Check every stop while the robot stands (``confirm_stop_m`` of
+        ``vc_gym/Homing-v0``): a stop whose estimated home moves farther than this
+        within ``stop_time_s`` is called off. ``None`` (default): stops are final in
+        training (evaluations of learned agents always check with
+        ``vc_gym.experiments.episode.LEARNED_CONFIRM_STOP_M``).
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
     net_arch : tuple of int
@@ -123,6 +129,7 @@ class TrainConfig:
     scene: str = "robolab"
     learn_time_s: float = 5.0
     stop_time_s: float = 0.1
+    confirm_stop_m: float | None = None
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
@@ -165,6 +172,8 @@ class TrainConfig:
         ):
             v = getattr(self, name)
             positive_float(name, v)
+        if self.confirm_stop_m is not None:
+            positive_float("confirm_stop_m", self.confirm_stop_m)
         if self.demo_episodes and self.algo != "ppo":
             raise ValueError("demo_episodes (the warm start) needs algo 'ppo'; use 0 with sac")
         if not (0 < self.gamma <= 1):
@@ -208,6 +217,8 @@ class TrainConfig:
 
     def env_kwargs(self) -> dict[str, Any]:
         """The ``vc_gym/Homing-v0`` arguments of this run (the agent's env)."""
+        # confirm_stop_m only when set: configs saved before it existed stay readable
+        checked = {} if self.confirm_stop_m is None else {"confirm_stop_m": self.confirm_stop_m}
         return {
             "scene": self.scene,
             "learn_time_s": self.learn_time_s,
@@ -217,6 +228,7 @@ class TrainConfig:
             "max_forward": self.max_forward,
             "max_turn_deg_s": self.max_turn_deg_s,
             "tracker": self.tracker,
+            **checked,
         }
 
     @classmethod
