@@ -75,3 +75,12 @@ def test_circular_std_rows_equals_circular_std_on_every_row():
 def test_circular_std_rows_rejects_bad_weights(weights):
     with pytest.raises(ValueError, match="weights"):
         circular_std_rows([0.0, 90.0, 180.0, 270.0], weights)
+
+
+@pytest.mark.parametrize(
+    ("step", "n"), [(1.0, 360), (4.5, 80), (0.1, 3600), (360 / 7, 7), (7.0, None), (0.7, None)]
+)
+def test_steps_in_circle(step, n):
+    from vc_gym.angles import steps_in_circle
+
+    assert steps_in_circle(step) == n

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 
 __all__ = [
     "MIN_HEADING_STEP_DEG",
+    "steps_in_circle",
     "wrap180",
     "wrap360",
     "circular_mean",
@@ -27,6 +28,13 @@ __all__ = [
 #: The finest heading grid any sensor takes (36,000 headings): a config, perhaps read
 #: from a file, cannot make it allocate more.
 MIN_HEADING_STEP_DEG = 0.01
+
+
+def steps_in_circle(step_deg: float) -> int | None:
+    """How many steps of ``step_deg`` make the full circle, or None if they do not
+    (``step_deg`` must divide 360 to within 1e-6 of a step; it is assumed > 0)."""
+    n = 360.0 / step_deg
+    return int(round(n)) if abs(n - round(n)) <= 1e-6 else None
 
 
 def wrap180(angle_deg: ArrayLike) -> np.ndarray | float:

@@ -18,7 +18,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from vc_gym.angles import MIN_HEADING_STEP_DEG, circular_std_rows, interp_circular, peak_headings
+from vc_gym.angles import (
+    MIN_HEADING_STEP_DEG,
+    circular_std_rows,
+    interp_circular,
+    peak_headings,
+    steps_in_circle,
+)
 from vc_gym.compass import Camera, CompassEstimate
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.filters.protocol import check_log_likelihood
@@ -42,10 +48,10 @@ def heading_grid(step_deg: float) -> np.ndarray:
     step = positive_float("heading_step_deg", step_deg)
     if step < MIN_HEADING_STEP_DEG:
         raise ValueError(f"heading_step_deg must be >= {MIN_HEADING_STEP_DEG}, got {step}")
-    n = 360.0 / step
-    if step > 90.0 or abs(n - round(n)) > 1e-9:
+    n = steps_in_circle(step)
+    if step > 90.0 or n is None:
         raise ValueError(f"heading_step_deg must divide 360 (and be <= 90), got {step}")
-    h = np.arange(int(round(n)), dtype=np.float64) * step
+    h = np.arange(n, dtype=np.float64) * step
     h.setflags(write=False)
     return h
 

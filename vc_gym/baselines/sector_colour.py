@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from vc_gym.angles import steps_in_circle
 from vc_gym.baselines.base import BaselineCompass, FrameScore
 from vc_gym.baselines.strip import StripGrid, angular_strip, strip_offsets
 from vc_gym.compass import Camera
@@ -210,10 +211,10 @@ class SectorColourCompass(BaselineCompass):
         self.sector_deg = positive_float("sector_deg", sector_deg)
         self._m = _whole_multiple("sector_deg", self.sector_deg, "az_step_deg", az)
         self._q = _whole_multiple("heading_step_deg", self.heading_step_deg, "az_step_deg", az)
-        n = 360.0 / self.sector_deg
-        if abs(n - round(n)) > 1e-9 or round(n) < 2:
+        n = steps_in_circle(self.sector_deg)
+        if n is None or n < 2:
             raise ValueError(f"sector_deg must divide 360 (and be <= 180), got {sector_deg}")
-        self.n_sectors = int(round(n))
+        self.n_sectors = n
         frac = positive_float("min_valid_fraction", min_valid_fraction)
         if frac > 1.0:
             raise ValueError(f"min_valid_fraction must be in (0, 1], got {frac}")

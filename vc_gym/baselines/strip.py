@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from vc_gym.angles import steps_in_circle
 from vc_gym.compass import Camera
 from vc_gym.validation import finite_float, positive_float
 
@@ -52,8 +53,7 @@ class StripGrid:
         az = positive_float("az_step_deg", self.az_step_deg)
         if az < MIN_AZ_STEP_DEG:
             raise ValueError(f"az_step_deg must be >= {MIN_AZ_STEP_DEG}, got {az}")
-        n = 360.0 / az
-        if az > 45.0 or abs(n - round(n)) > 1e-9:
+        if az > 45.0 or steps_in_circle(az) is None:
             raise ValueError(f"az_step_deg must divide 360 (and be <= 45), got {az}")
         lo = finite_float("el_min_deg", self.el_min_deg)
         hi = finite_float("el_max_deg", self.el_max_deg)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, fields
 
-from vc_gym.angles import MIN_HEADING_STEP_DEG
+from vc_gym.angles import MIN_HEADING_STEP_DEG, steps_in_circle
 
 __all__ = ["CompassConfig", "EXPOSURE_MODES", "MAX_MAP_ENTRIES", "MIN_COVERAGE"]
 
@@ -16,11 +16,6 @@ MIN_COVERAGE = 0.001
 #: Most counts a map may hold (``n_sectors · n_colors² · n_bins``; 128 MB as float64).
 #: The paper's map holds 64,000; 1° sectors with 32 classes and 32 bins 11.8 million.
 MAX_MAP_ENTRIES = 2**24
-
-
-def _is_divisor_of_360(step: float) -> bool:
-    n = 360.0 / step
-    return abs(n - round(n)) < 1e-6
 
 
 @dataclass(frozen=True)
@@ -92,7 +87,7 @@ class CompassConfig:
                     raise ValueError(f"{f.name} must be a finite number, got {v!r}")
         if not 1 <= self.n_colors <= 32:
             raise ValueError(f"n_colors must be in 1..32, got {self.n_colors}")
-        if not 0 < self.sector_deg <= 90 or not _is_divisor_of_360(self.sector_deg):
+        if not 0 < self.sector_deg <= 90 or steps_in_circle(self.sector_deg) is None:
             raise ValueError(f"sector_deg must be in (0, 90] and divide 360, got {self.sector_deg}")
         if not 2 <= self.n_bins <= 32:
             raise ValueError(f"n_bins must be in 2..32, got {self.n_bins}")
@@ -108,7 +103,7 @@ class CompassConfig:
             # below it the grid's steps exceed a small image: it would learn nothing
             raise ValueError(f"coverage must be in [{MIN_COVERAGE}, 1], got {self.coverage}")
         step = self.heading_step_deg
-        if not MIN_HEADING_STEP_DEG <= step <= 90 or not _is_divisor_of_360(step):
+        if not MIN_HEADING_STEP_DEG <= step <= 90 or steps_in_circle(step) is None:
             # a map file's config must not make the compass allocate 360 / 1e-9 headings
             raise ValueError(
                 f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG}, 90] and divide 360, "

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.angles import circular_mean, circular_std
+from vc_gym.angles import circular_mean, circular_std, steps_in_circle
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
 from vc_gym.validation import finite_float as _finite
@@ -76,8 +76,8 @@ class HeadingGridFilter:
         dt_s: float = 1.0 / 30.0,
     ):
         res = _finite("resolution_deg", resolution_deg)
-        n = 360.0 / res if res > 0 else 0.0
-        if res <= 0 or res > 90 or abs(n - round(n)) > 1e-6:
+        n_bins = steps_in_circle(res) if 0 < res <= 90 else None
+        if n_bins is None:
             raise ValueError(f"resolution_deg must be in (0, 90] and divide 360, got {res}")
         if rule not in RULES:
             raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
@@ -86,7 +86,6 @@ class HeadingGridFilter:
         self.rule = rule
         self.half_life_s = float(half_life_s)
         self.dt_s = float(dt_s)
-        n_bins = int(round(n))
         h = np.arange(n_bins, dtype=np.float64) * res
         h.setflags(write=False)
         self._headings = h

@@ -116,10 +116,12 @@ GRID_AROUND_M = 0.5
 
 
 def training_spots(
-    bounds: Sequence[float], mode: str = "paper", spacing_m: float = GRID_SPACING_M
+    bounds: Sequence[float], mode: str = "paper", spacing_m: float | None = None
 ) -> list[tuple[float, float]]:
-    """The spots a mode learns: the paper's one, or a grid ``spacing_m`` apart with the
-    one nearest it first."""
+    """The spots a mode learns: the paper's one, or a grid ``spacing_m`` apart
+    (default :data:`GRID_SPACING_M`) with the one nearest it first."""
+    if spacing_m is None:
+        spacing_m = GRID_SPACING_M
     if mode not in VIEW_MODES:
         raise ValueError(f"mode must be one of {list(VIEW_MODES)}, got {mode!r}")
     centre = rear_half_centre(bounds)
@@ -383,7 +385,7 @@ def orientation_stage(
     spots) and the field bounds.
     """
     bounds = scene_field_bounds(scene)
-    spots = training_spots(bounds, mode, size.get("spots_m", GRID_SPACING_M))
+    spots = training_spots(bounds, mode, size.get("spots_m"))
     compass = {**VIEW_MODES[mode], **dict(compass or {})}
     if mode == "paper":
         spot: Any = spots[0]
