@@ -166,3 +166,17 @@ def test_a_deeply_nested_config_is_a_map_file_error(room_compass, tmp_path):
     path = _zip(tmp_path / "deep.npz", {**schema, **entries})
     with pytest.raises(MapFileError, match="deep.npz.*nested too deeply"):
         VisualCompass.load(path)
+
+
+@pytest.mark.parametrize(("umask", "expected"), [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
+def test_saved_files_get_the_permissions_of_the_umask(tmp_path, umask, expected):
+    """A map used to be written 0600 whatever the umask (the temporary file's mode)."""
+    import os
+    import stat
+
+    old = os.umask(umask)
+    try:
+        path = save_npz_atomic(tmp_path / "map.npz", SCHEMA, VERSION, {"a": np.arange(3.0)})
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(path.stat().st_mode) == expected
