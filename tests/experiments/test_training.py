@@ -22,6 +22,7 @@ TINY = TrainConfig(
     n_steps=32,
     batch_size=32,
     max_homing_s=3.0,
+    stop_time_s=0.3,  # the check runs over 3 steps (the default 5 s would make 50)
     eval_freq=32,
     eval_episodes=2,
     save_freq=32,
@@ -222,13 +223,16 @@ def test_config_file_round_trip_and_errors(tmp_path):
     assert TrainConfig.from_dict({**schema1, "schema": 1}) == TINY
 
 
-def test_a_checked_stop_in_training_reaches_the_env_and_old_configs_still_load():
-    checked = replace(TINY, confirm_stop_m=0.25, stop_time_s=5.0)
-    assert checked.env_kwargs()["confirm_stop_m"] == 0.25
-    assert TrainConfig.from_dict(checked.to_dict()) == checked
-    assert "confirm_stop_m" not in TINY.env_kwargs()  # configs saved before it existed
-    saved_before = {k: v for k, v in TINY.to_dict().items() if k != "confirm_stop_m"}
-    assert TrainConfig.from_dict(saved_before) == TINY
+def test_stops_are_checked_in_training_and_old_configs_keep_their_final_stops():
+    assert TrainConfig().confirm_stop_m == 0.25 and TrainConfig().stop_time_s == 5.0
+    assert TINY.env_kwargs()["confirm_stop_m"] == 0.25
+    assert TrainConfig.from_dict(TINY.to_dict()) == TINY
+    final = replace(TINY, confirm_stop_m=None)
+    assert "confirm_stop_m" not in final.env_kwargs()
+    assert TrainConfig.from_dict(final.to_dict()) == final
+    # a config.json written before the field existed: its stops were final
+    saved_before = {k: v for k, v in final.to_dict().items() if k != "confirm_stop_m"}
+    assert TrainConfig.from_dict(saved_before) == final
 
 
 def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):

@@ -40,7 +40,8 @@ __all__ = [
 #: A learned agent's stop is checked while it stands for the task's 5 s, as the scripted
 #: agent checks its own (its walk resumes beyond ``rearm_factor × home_tolerance_m`` =
 #: 0.25 m): :class:`~vc_gym.envs.StopAction`'s ``confirm_stop_m``. On 99 held-out
-#: kidnappings it took the three PPO policies from 82 ± 2 % to 86 ± 6 % success (README).
+#: kidnappings it took the three PPO policies trained with final stops from 82 ± 2 % to
+#: 86 ± 6 % success (README). Training checks stops the same way (``TrainConfig``).
 LEARNED_CONFIRM_STOP_M = 0.25
 
 

@@ -26,6 +26,7 @@ from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
 from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.scenes import check_scene_name
+from vc_gym.experiments.episode import LEARNED_CONFIRM_STOP_M
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import make_tracker
@@ -72,16 +73,17 @@ class TrainConfig:
     learn_time_s, success_radius_m, max_homing_s : float
         Task parameters (see ``LearnThenHomeEnv``).
     stop_time_s : float
-        How long the robot must stand still to end an episode *in training* (one step).
-        The robot does not move while it stands, so the outcome (where it stopped) and
-        the rewards are those of the paper's 5 s; training just wastes fewer
-        simulated seconds. Evaluation uses the task's 5 s.
+        How long the robot must stand still to end an episode in training (default:
+        the task's 5 s, as in every evaluation).
     confirm_stop_m : float, optional
         Check every stop while the robot stands (``confirm_stop_m`` of
         ``vc_gym/Homing-v0``): a stop whose estimated home moves farther than this
-        within ``stop_time_s`` is called off. ``None`` (default): stops are final in
-        training (evaluations of learned agents always check with
-        ``vc_gym.experiments.episode.LEARNED_CONFIRM_STOP_M``).
+        within ``stop_time_s`` is called off and the policy decides again. Default
+        0.25 m, what every evaluation of a learned agent does
+        (``vc_gym.experiments.episode.LEARNED_CONFIRM_STOP_M``), so the policy learns
+        with the check it is evaluated with (README: 87 ± 5 % and 25.0 ± 4.6 cm on 99
+        held-out kidnappings, against 86 ± 6 % and 27.1 ± 4.4 cm trained with final
+        stops of 0.1 s). ``None``: a stop is final.
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
     net_arch : tuple of int
@@ -128,8 +130,8 @@ class TrainConfig:
     places: tuple[int, ...] = ()
     scene: str = "robolab"
     learn_time_s: float = 5.0
-    stop_time_s: float = 0.1
-    confirm_stop_m: float | None = None
+    stop_time_s: float = 5.0
+    confirm_stop_m: float | None = LEARNED_CONFIRM_STOP_M
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
@@ -217,7 +219,7 @@ class TrainConfig:
 
     def env_kwargs(self) -> dict[str, Any]:
         """The ``vc_gym/Homing-v0`` arguments of this run (the agent's env)."""
-        # confirm_stop_m only when set: configs saved before it existed stay readable
+        # confirm_stop_m only when set, as configs saved before it existed have it
         checked = {} if self.confirm_stop_m is None else {"confirm_stop_m": self.confirm_stop_m}
         return {
             "scene": self.scene,
@@ -246,6 +248,8 @@ class TrainConfig:
         for name in ("net_arch", "places"):
             if isinstance(data.get(name), list):
                 data[name] = tuple(data[name])
+        # a config saved before stops were checked in training had final stops
+        data.setdefault("confirm_stop_m", None)
         config = cls(**data)
         if env is not None and env != config.env_kwargs():
             raise ValueError("the config's 'env' does not match its own fields")
