@@ -84,3 +84,11 @@ def test_steps_in_circle(step, n):
     from vc_gym.angles import steps_in_circle
 
     assert steps_in_circle(step) == n
+
+
+@pytest.mark.parametrize("bad", [0.0, -4.5, float("nan"), float("inf"), True, "4.5"])
+def test_steps_in_circle_refuses_what_is_not_a_step(bad):
+    from vc_gym.angles import steps_in_circle
+
+    with pytest.raises(ValueError, match="step_deg"):
+        steps_in_circle(bad)

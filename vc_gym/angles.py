@@ -32,7 +32,17 @@ MIN_HEADING_STEP_DEG = 0.01
 
 def steps_in_circle(step_deg: float) -> int | None:
     """How many steps of ``step_deg`` make the full circle, or None if they do not
-    (``step_deg`` must divide 360 to within 1e-6 of a step; it is assumed > 0)."""
+    (``step_deg`` must divide 360 to within 1e-6 of a step).
+
+    Raises
+    ------
+    ValueError
+        If ``step_deg`` is not a finite number > 0.
+    """
+    if isinstance(step_deg, bool) or not isinstance(step_deg, (int, float, np.number)):
+        raise ValueError(f"step_deg must be a number, got {step_deg!r}")
+    if not (math.isfinite(step_deg) and step_deg > 0):
+        raise ValueError(f"step_deg must be finite and > 0, got {step_deg!r}")
     n = 360.0 / step_deg
     return int(round(n)) if abs(n - round(n)) <= 1e-6 else None
 

@@ -159,8 +159,9 @@ def change_ratio(classes: np.ndarray, n_colors: int) -> float:
         ``q / e``: ``q`` is the fraction of vertical neighbour pairs whose classes
         differ, ``e = 1 - Σ_k p_k²`` the fraction that would differ if the pixels were
         drawn independently with the frame's class frequencies ``p_k``. Images of a
-        scene are made of regions and edges (well below 1); noise is near 1. 0 for a
-        frame of one class or fewer than two rows.
+        scene are made of regions and edges (well below 1); noise is near 1. Exactly 0
+        if and only if no class changes between vertical neighbours (including a frame
+        of one class or of fewer than two rows).
     """
     if classes.shape[0] < 2 or classes.size == 0:
         return 0.0

@@ -471,9 +471,8 @@ class VisualCompass:
         geom = self._geometry(camera, w, h)
         classes = self._scanned_classes(image, geom)
         colcounts = self._column_counts(classes)
-        c = self.config.n_colors
-        no_change = not colcounts.reshape(-1, c, c).sum(axis=0)[~np.eye(c, dtype=bool)].any()
-        if no_change or change_ratio(classes, c) >= NOISE_CHANGE_RATIO:
+        ratio = change_ratio(classes, self.config.n_colors)
+        if ratio == 0.0 or ratio >= NOISE_CHANGE_RATIO:  # no class change at all, or noise
             colcounts = np.zeros_like(colcounts)
         # integer counts in float32: the cumulative sums and their differences are exact
         cum = np.zeros((colcounts.shape[0] + 1, colcounts.shape[1]), dtype=colcounts.dtype)
