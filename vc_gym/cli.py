@@ -355,12 +355,22 @@ def _cmd_compass_experiment(args: argparse.Namespace) -> int:
             return 2
         result = run_real_rotation(data, progress=not args.json)
         if not args.json:
-            print(f"{'set':22s} {'classes':>7s} {'exposure':>8s} {'median':>8s} {'<5°':>5s}")
+            print(
+                f"{'set':22s} {'light':>5s} {'classes':>7s} {'exposure':>8s} "
+                f"{'median':>8s} {'<5°':>5s}"
+            )
             for r in result["results"]:
-                print(
-                    f"{r['set']:22s} {r['n_colors']:7d} {r['exposure']:>8s} "
+                line = (
+                    f"{r['set']:22s} {r['light']:5.2f} {r['n_colors']:7d} {r['exposure']:>8s} "
                     f"{r['median_error_deg']:7.2f}° {r['within_5deg']:5.0%}"
                 )
+                if "session_gain" in r:
+                    line += (
+                        f"  (session gain {r['session_gain']:.2f}; per frame "
+                        f"{r['per_frame_median_error_deg']:.2f}°, "
+                        f"{r['per_frame_within_5deg']:.0%})"
+                    )
+                print(line)
         write_json(out / "results.json", result)
     if args.json:
         print(json.dumps(result))
@@ -824,7 +834,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "real-rotation",
                 "learn from 9 alternate photos of a camera turning in place and estimate the "
                 "yaw of crops of the other 9 (indoor and outdoor sets, 10 and 3 colour "
-                "classes, without and with exposure normalisation)",
+                "classes, exposure none/mean/map, crops at full and half light)",
             )
             + "\n"
             + entry(

@@ -93,7 +93,8 @@ def test_sector_counts_are_the_columns_summed_by_sector(room_pano, room_compass,
     that sector (the counts behind eq. 11, per sector)."""
     image = render_view(room_pano, camera.replace(yaw_deg=33.0))
     geom, counts, total = room_compass._sector_features(image, camera)
-    colcounts = room_compass._column_counts(room_compass._scanned_classes(image, geom))
+    pixels = image[geom.row_slice, geom.col_slice]
+    colcounts = room_compass._column_counts(room_compass._scanned_classes(pixels))
     delta = room_compass.config.sector_deg
     headings = room_compass._headings
     phases = np.unique(np.round(headings - np.floor(headings / delta + 1e-9) * delta, 9))

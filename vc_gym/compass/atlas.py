@@ -159,9 +159,12 @@ class CompassAtlas:
         in order, so the stacked tables are read whole)."""
         compasses = [self.compasses[k] for k in which]
         first = compasses[0]
-        if all(vc.colors is first.colors for vc in self.compasses):
+        if first.config.exposure != "map" and all(
+            vc.colors is first.colors for vc in self.compasses
+        ):
             # one colour set and config (the usual case): the image's sector features
-            # are the same for every spot, so compute them once
+            # are the same for every spot, so compute them once (not with
+            # exposure="map": every map brings the frame to its own learned light)
             for vc in compasses:
                 vc._checked(image, camera, need_map=True)
             features = first._sector_features(image, camera)

@@ -10,7 +10,7 @@ from vc_gym.angles import MIN_HEADING_STEP_DEG, steps_in_circle
 __all__ = ["CompassConfig", "EXPOSURE_MODES", "MAX_MAP_ENTRIES", "MIN_COVERAGE"]
 
 #: Accepted values of :attr:`CompassConfig.exposure`.
-EXPOSURE_MODES = ("none", "mean")
+EXPOSURE_MODES = ("none", "mean", "map")
 #: Smallest scanning coverage (0.1 %); the paper reports that < 1 % still works.
 MIN_COVERAGE = 0.001
 #: Most counts a map may hold (``n_sectors · n_colors² · n_bins``; 128 MB as float64).
@@ -56,7 +56,12 @@ class CompassConfig:
         ``"none"`` (the paper) classifies pixels as they are. ``"mean"`` first scales
         each frame's scanned pixels in linear light so that their mean level equals
         that of the colour-fitting images, which undoes a change of illumination
-        or camera exposure (beyond the paper; see the README for measurements).
+        or camera exposure (beyond the paper; see the README for measurements), but
+        also brightens a view of dark things and darkens one of the sky. ``"map"``
+        also learns the mean light of every sector and scores each candidate heading
+        with the gain that brings the frame to the light learned in the directions
+        it would then see (:mod:`vc_gym.compass.light_map`); it costs one
+        classification per distinct gain (about 5-15 per frame).
     """
 
     n_colors: int = 10

@@ -27,10 +27,12 @@ from vc_gym.compass.features import (
     log2_bin,
     scan_grid,
 )
+from vc_gym.compass.light_map import GAIN_STEP_STOPS, LightMap, column_levels, quantized_stops
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.exposure import gain_table, mean_linear_level
 from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
+from vc_gym.validation import positive_float
 
 __all__ = ["VisualCompass", "CompassEstimate"]
 
@@ -139,6 +141,7 @@ class VisualCompass:
         c2 = cfg.n_colors**2
         self._counts = np.zeros((cfg.n_sectors, c2, cfg.n_bins), dtype=np.float64)
         self._n_obs = np.zeros(cfg.n_sectors, dtype=np.float64)
+        self._light = LightMap(cfg.n_sectors)  # learned only with exposure="map"
         self._frames = 0
         self._sizes: set[tuple[int, int]] = set()  # (H, W) of the learned frames
         self._tables: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
@@ -258,6 +261,7 @@ class VisualCompass:
         """Forget every learned frame (keeps the colour classes)."""
         self._counts[:] = 0
         self._n_obs[:] = 0
+        self._light.clear()
         self._frames = 0
         self._sizes.clear()
         self._tables = None
@@ -328,12 +332,15 @@ class VisualCompass:
             return pixels
         return np.take(gain_table(ref / level), pixels)
 
-    def _scanned_classes(self, image: np.ndarray, geom: _Geometry) -> np.ndarray:
-        """``(R, U)`` class ids of the scanned grid (after the exposure correction)."""
+    def _scanned_classes(self, pixels: np.ndarray, gain: float = 1.0) -> np.ndarray:
+        """``(R, U)`` class ids of the scanned ``pixels`` after the exposure correction:
+        ``exposure="mean"`` scales the frame to the reference level, otherwise the
+        linear light is multiplied by ``gain``."""
         assert self._colors is not None
-        pixels = image[geom.row_slice, geom.col_slice]
         if self.config.exposure == "mean":
             pixels = self._apply_gain(pixels, mean_linear_level(pixels), self._exposure_ref)
+        elif gain != 1.0:
+            pixels = np.take(gain_table(gain), pixels)
         return self._colors.classify_pixels(pixels)
 
     def _column_counts(self, classes: np.ndarray) -> np.ndarray:
@@ -369,7 +376,8 @@ class VisualCompass:
         self._checked(image, camera, need_map=False)
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
-        colcounts = self._column_counts(self._scanned_classes(image, geom))
+        pixels = image[geom.row_slice, geom.col_slice]
+        colcounts = self._column_counts(self._scanned_classes(pixels))
         cfg = self.config
         sector = (
             np.floor((camera.yaw_deg + geom.grid.offsets_deg) / cfg.sector_deg + 1e-9).astype(
@@ -390,6 +398,8 @@ class VisualCompass:
         bins = log2_bin(z, cfg.n_bins)
         self._counts[seen[:, None], np.arange(c2)[None, :], bins] += 1.0
         self._n_obs[seen] += 1.0
+        if cfg.exposure == "map":
+            self._light.add(sector, column_levels(pixels))
         self._frames += 1
         self._sizes.add((h, w))
         self._tables = None
@@ -420,6 +430,7 @@ class VisualCompass:
             raise ValueError("cannot merge maps learned with different colour classes")
         self._counts += other._counts
         self._n_obs += other._n_obs
+        self._light.merge(other._light)
         self._frames += other._frames
         self._sizes |= other._sizes
         self._tables = None
@@ -453,7 +464,7 @@ class VisualCompass:
         return self._tables
 
     def _sector_features(
-        self, image: np.ndarray, camera: Camera
+        self, image: np.ndarray, camera: Camera, gain: float = 1.0
     ) -> tuple[_Geometry, np.ndarray, np.ndarray]:
         """Counts per (phase, relative sector, pair) and which of them saw anything.
 
@@ -469,7 +480,13 @@ class VisualCompass:
         """
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
-        classes = self._scanned_classes(image, geom)
+        return (geom, *self._features_of(image[geom.row_slice, geom.col_slice], geom, gain))
+
+    def _features_of(
+        self, pixels: np.ndarray, geom: _Geometry, gain: float = 1.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``(counts, total)`` of :meth:`_sector_features` from the scanned pixels."""
+        classes = self._scanned_classes(pixels, gain)
         colcounts = self._column_counts(classes)
         ratio = change_ratio(classes, self.config.n_colors)
         if ratio == 0.0 or ratio >= NOISE_CHANGE_RATIO:  # no class change at all, or noise
@@ -479,9 +496,42 @@ class VisualCompass:
         np.cumsum(colcounts, axis=0, out=cum[1:])
         counts = cum[geom.stop_col] - cum[geom.first_col]  # (P*K, c2)
         total = counts.sum(axis=1)
-        return geom, counts, total
+        return counts, total
 
-    def log_likelihood(self, image: np.ndarray, camera: Camera) -> np.ndarray:
+    def _light_profile(
+        self, image: np.ndarray, camera: Camera
+    ) -> tuple[np.ndarray, tuple[_Geometry, np.ndarray, np.ndarray], int]:
+        """``exposure="map"``: log-likelihood over headings, each heading's features
+        classified with the gain that brings the frame to the light the map learned in
+        the directions that heading puts in view (see :mod:`vc_gym.compass.light_map`).
+
+        Returns the log-likelihoods, and the sector features and the gain (in steps of
+        :data:`~vc_gym.compass.light_map.GAIN_STEP_STOPS`) of the best heading.
+        """
+        h, w = image.shape[:2]
+        geom = self._geometry(camera, w, h)
+        pixels = image[geom.row_slice, geom.col_slice]
+        gains = self._light.heading_gains(
+            column_levels(pixels),
+            geom.first_col,
+            geom.stop_col,
+            geom.n_rel,
+            geom.heading_phase,
+            geom.roll_index[:, geom.heading_sector],
+        )
+        steps = quantized_stops(gains)
+        ll = np.empty(steps.size)
+        features: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        for k in np.unique(steps).tolist():
+            features[k] = self._features_of(pixels, geom, 2.0 ** (k * GAIN_STEP_STOPS))
+            at = steps == k
+            ll[at] = self._log_likelihood_of(geom, *features[k])[at]
+        best = int(steps[int(np.argmax(ll))])
+        return ll, (geom, *features[best]), best
+
+    def log_likelihood(
+        self, image: np.ndarray, camera: Camera, gain: float | None = None
+    ) -> np.ndarray:
         """Log-likelihood of every candidate heading for one image (eq. 5, 15-16).
 
         Parameters
@@ -490,6 +540,11 @@ class VisualCompass:
             ``(H, W, 3)`` uint8 RGB camera image.
         camera : Camera
             Intrinsics and pitch of the camera; its ``yaw_deg`` is ignored.
+        gain : float, optional
+            Multiply the image's linear light by this before classifying it (a light
+            level known for the whole session, e.g. the median of :meth:`light_gain`
+            over its frames). Not with ``exposure="mean"``, which sets its own gain.
+            With ``exposure="map"`` the default is a gain per candidate heading.
 
         Returns
         -------
@@ -499,7 +554,10 @@ class VisualCompass:
             ``config.temperature``. All zeros if nothing above the horizon is visible.
         """
         self._checked(image, camera, need_map=True)
-        return self._log_likelihood_of(*self._sector_features(image, camera))
+        gain = self._checked_gain(gain)
+        if gain is None and self.config.exposure == "map":
+            return self._light_profile(image, camera)[0]
+        return self._log_likelihood_of(*self._sector_features(image, camera, gain or 1.0))
 
     def _log_likelihood_of(
         self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
@@ -510,13 +568,40 @@ class VisualCompass:
             self.config, geom, counts, total, delta_t[:, None, :], base[None]
         )[0]
 
-    def estimate(self, image: np.ndarray, camera: Camera) -> CompassEstimate:
+    def estimate(
+        self, image: np.ndarray, camera: Camera, gain: float | None = None
+    ) -> CompassEstimate:
         """Best heading, its spread and the goodness of fit for one image.
 
-        See :class:`CompassEstimate` for the meaning of each number (eq. 25-28).
+        See :class:`CompassEstimate` for the meaning of each number (eq. 25-28) and
+        :meth:`log_likelihood` for ``gain``.
         """
         self._checked(image, camera, need_map=True)
-        return self._estimate_of(*self._sector_features(image, camera))
+        gain = self._checked_gain(gain)
+        if gain is None and self.config.exposure == "map":
+            ll, features, _ = self._light_profile(image, camera)
+            return _estimates_of([self], *features, ll[None])[0]
+        return self._estimate_of(*self._sector_features(image, camera, gain or 1.0))
+
+    def light_gain(self, image: np.ndarray, camera: Camera) -> float:
+        """``exposure="map"``: the gain that brings this frame to the learned light.
+
+        It is the gain of the heading that fits best when every heading is scored with
+        its own gain (see :meth:`log_likelihood`), in steps of a third of a stop. One
+        frame's answer is wrong when its best heading is; the median over the frames
+        of a session is a robust estimate of the session's light (pass it as ``gain``).
+        """
+        if self.config.exposure != "map":
+            raise ValueError(f"light_gain needs exposure='map', not {self.config.exposure!r}")
+        self._checked(image, camera, need_map=True)
+        return float(2.0 ** (self._light_profile(image, camera)[2] * GAIN_STEP_STOPS))
+
+    def _checked_gain(self, gain: float | None) -> float | None:
+        if gain is None:
+            return None
+        if self.config.exposure == "mean":
+            raise ValueError("exposure='mean' sets its own gain per frame: pass gain=None")
+        return positive_float("gain", gain)
 
     def _estimate_of(
         self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
@@ -549,6 +634,9 @@ class VisualCompass:
             "exposure_reference": np.array(self._exposure_ref, dtype=np.float64),
             "learned_sizes": np.array(sorted(self._sizes), dtype=np.int64).reshape(-1, 2),
         }
+        if self.config.exposure == "map":
+            arrays["light_sum"] = self._light.level_sum.copy()
+            arrays["light_columns"] = self._light.columns.copy()
         if with_colors:
             arrays.update(self._colors.to_arrays())
         return arrays
@@ -660,6 +748,8 @@ class VisualCompass:
             or np.any(sizes < 1)
         ):
             raise MapFileError(f"{path}: entry 'learned_sizes' missing or not an (N, 2) int array")
+        if stored.exposure == "map":
+            _read_light(vc._light, arrays, path)
         vc._counts[:] = counts
         vc._n_obs[:] = n_obs
         vc._frames = frames
@@ -808,6 +898,28 @@ def _scores_at(
             scores[k] = float(log_abs[sectors[:, None], pairs, bins].mean())
             used[k] = int(seen.size)
     return scores, used
+
+
+def _read_light(light: LightMap, arrays: Mapping[str, np.ndarray], path: object) -> None:
+    """Fill ``light`` from a map file's ``light_sum`` and ``light_columns``, checked."""
+    shape = light.level_sum.shape
+    read = []
+    for key in ("light_sum", "light_columns"):
+        a = arrays.get(key)
+        if a is None or a.shape != shape or a.dtype.kind not in "iuf":
+            raise MapFileError(
+                f"{path}: exposure='map' needs entry {key!r}: a number per sector, shape {shape}"
+            )
+        a = a.astype(np.float64)
+        if not np.all(np.isfinite(a)) or np.any(a < 0):
+            raise MapFileError(f"{path}: entry {key!r} must be finite and >= 0")
+        read.append(a)
+    level_sum, columns = read
+    # every column's mean level is at most 1 (linear light)
+    if np.any(level_sum > columns * (1 + 1e-9)):
+        raise MapFileError(f"{path}: light_sum exceeds light_columns (levels above 1)")
+    light.level_sum[:] = level_sum
+    light.columns[:] = columns
 
 
 def _same_colors(a: ColorClasses, b: ColorClasses) -> bool:

@@ -4,6 +4,8 @@ For each rotation set (18 photos over a full turn, yaw ground truth from the
 stitching of the photos): fit colour classes on and learn from 9 alternate photos,
 then estimate the yaw of crops of the other 9 photos. A crop keeps the photo's focal
 length and optical axis (its principal point moves), so its true yaw is the photo's.
+With ``light`` below 1 the crops are darkened in linear light (the paper's
+illumination test, section 5.3, on real photos); the training photos never are.
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ import numpy as np
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassConfig, ImageCompass, VisualCompass
 from vc_gym.experiments.real_data import ROTATION_SETS, RotationPhoto, load_rotation_set
+from vc_gym.exposure import gain_table
+from vc_gym.validation import positive_float
 
 __all__ = ["crop_columns", "evaluate_rotation_set", "rotation_set_errors", "run_real_rotation"]
 
@@ -50,6 +54,8 @@ def rotation_set_errors(
     crop_width_frac: float = 0.5,
     crops_per_photo: int = 3,
     setup: Callable[[ImageCompass, list[tuple[np.ndarray, Camera]]], None] | None = None,
+    light: float = 1.0,
+    session_gain: bool = False,
 ) -> dict[str, Any]:
     """Teach ``sensor`` the even photos, then estimate the yaw of crops of the odd ones.
 
@@ -69,15 +75,25 @@ def rotation_set_errors(
     setup : callable, optional
         ``setup(sensor, frames)`` before ``prepare``, not timed (e.g. fitting colour
         classes: once per place, not a cost per frame).
+    light : float
+        Linear light of the test crops relative to the photos (1: as taken).
+    session_gain : bool
+        Estimate the light of the whole session first, as the median of the sensor's
+        per-crop :meth:`~vc_gym.compass.VisualCompass.light_gain`, then estimate
+        every crop with that gain (a visual compass with ``exposure="map"``).
 
     Returns
     -------
     dict
-        ``errors_deg`` and ``crops`` per crop, ``n_train``, and the milliseconds per
-        frame to learn (``learn_ms``) and to estimate (``localise_ms``, median).
+        ``errors_deg`` and ``crops`` per crop, ``n_train``, the milliseconds per
+        frame to learn (``learn_ms``) and to estimate (``localise_ms``, median), and
+        with ``session_gain`` the ``gain`` used.
     """
     if len(photos) < 4:
         raise ValueError(f"need at least 4 photos, got {len(photos)}")
+    light = positive_float("light", light)
+    if session_gain and not (isinstance(sensor, VisualCompass) and sensor.config.exposure == "map"):
+        raise ValueError("session_gain needs a VisualCompass with exposure='map'")
     train, test = photos[0::2], photos[1::2]
     frames = [
         (p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg)) for p in train
@@ -87,32 +103,49 @@ def rotation_set_errors(
     t0 = time.perf_counter()
     (prepare or _learn_all)(sensor, frames)
     learn_ms = 1e3 * (time.perf_counter() - t0) / len(frames)
-    errors, crops, cost = [], [], []
+    tests = []
     for p in test:
         w = p.image.shape[1]
         cw = max(2, int(round(w * crop_width_frac)))
         for left in np.linspace(0, w - cw, crops_per_photo).round().astype(int):
             crop, cam = crop_columns(p, int(left), cw)
-            t0 = time.perf_counter()
-            est = sensor.estimate(crop, cam)
-            cost.append(1e3 * (time.perf_counter() - t0))
-            errors.append(abs(float(wrap180(est.heading_deg - p.yaw_deg))))
-            crops.append(
-                {
-                    "photo": p.name,
-                    "left": int(left),
-                    "width": cw,
-                    "true_yaw_deg": p.yaw_deg,
-                    "estimate_deg": est.heading_deg,
-                    "spread_deg": est.spread_deg,
-                }
-            )
+            if light != 1.0:
+                crop = np.take(gain_table(light), crop)
+            tests.append((p, int(left), cw, crop, cam))
+    extra: dict[str, Any] = {}
+    estimate = sensor.estimate
+    if session_gain:
+        assert isinstance(sensor, VisualCompass)
+        gains = [sensor.light_gain(crop, cam) for *_, crop, cam in tests]
+        gain = float(2.0 ** np.median(np.log2(gains)))
+        extra["gain"] = gain
+
+        def estimate(image: np.ndarray, camera: Camera) -> Any:
+            return sensor.estimate(image, camera, gain=gain)
+
+    errors, crops, cost = [], [], []
+    for p, left, cw, crop, cam in tests:
+        t0 = time.perf_counter()
+        est = estimate(crop, cam)
+        cost.append(1e3 * (time.perf_counter() - t0))
+        errors.append(abs(float(wrap180(est.heading_deg - p.yaw_deg))))
+        crops.append(
+            {
+                "photo": p.name,
+                "left": left,
+                "width": cw,
+                "true_yaw_deg": p.yaw_deg,
+                "estimate_deg": est.heading_deg,
+                "spread_deg": est.spread_deg,
+            }
+        )
     return {
         "errors_deg": errors,
         "crops": crops,
         "n_train": len(train),
         "learn_ms": learn_ms,
         "localise_ms": float(np.median(cost)),
+        **extra,
     }
 
 
@@ -121,8 +154,14 @@ def evaluate_rotation_set(
     config: CompassConfig,
     crop_width_frac: float = 0.5,
     crops_per_photo: int = 3,
+    light: float = 1.0,
 ) -> dict[str, object]:
     """Learn from the even photos, estimate the yaw of crops of the odd ones.
+
+    With ``config.exposure == "map"`` the crops are estimated twice: each with its own
+    gain per candidate heading (``per_frame_*`` figures), and all with the session's
+    gain, the median of their :meth:`~vc_gym.compass.VisualCompass.light_gain` (the
+    main figures and ``session_gain``).
 
     Returns
     -------
@@ -131,20 +170,26 @@ def evaluate_rotation_set(
         ``learned_fraction`` (of the circle covered by training photos), ``errors_deg``
         per crop and the crop details.
     """
-    vc = VisualCompass(config)
 
     def fit_colours(sensor: VisualCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
         sensor.fit_colors([image for image, _ in frames])
 
-    r = rotation_set_errors(
-        photos,
-        vc,
-        crop_width_frac=crop_width_frac,
-        crops_per_photo=crops_per_photo,
-        setup=fit_colours,
-    )
+    def errors(session_gain: bool) -> tuple[VisualCompass, dict[str, Any]]:
+        vc = VisualCompass(config)
+        r = rotation_set_errors(
+            photos,
+            vc,
+            crop_width_frac=crop_width_frac,
+            crops_per_photo=crops_per_photo,
+            setup=fit_colours,
+            light=light,
+            session_gain=session_gain,
+        )
+        return vc, r
+
+    vc, r = errors(session_gain=config.exposure == "map")
     e = np.array(r["errors_deg"])
-    return {
+    out: dict[str, object] = {
         "median_error_deg": float(np.median(e)),
         "mean_error_deg": float(np.mean(e)),
         "within_5deg": float(np.mean(e < 5.0)),
@@ -155,17 +200,28 @@ def evaluate_rotation_set(
         "errors_deg": [round(float(x), 3) for x in e],
         "crops": r["crops"],
     }
+    if config.exposure == "map":
+        out["session_gain"] = r["gain"]
+        per_frame = np.array(errors(session_gain=False)[1]["errors_deg"])
+        out["per_frame_median_error_deg"] = float(np.median(per_frame))
+        out["per_frame_within_5deg"] = float(np.mean(per_frame < 5.0))
+    return out
 
 
 def run_real_rotation(
     data_dir: str | os.PathLike,
     n_colors: tuple[int, ...] = (10, 3),
-    exposures: tuple[str, ...] = ("none", "mean"),
+    exposures: tuple[str, ...] = ("none", "mean", "map"),
+    lights: tuple[float, ...] = (1.0, 0.5),
     progress: bool = False,
 ) -> dict[str, object]:
-    """Run :func:`evaluate_rotation_set` on every rotation set for several configs."""
+    """Run :func:`evaluate_rotation_set` on every rotation set for several configs
+    and lights of the test crops."""
     data_dir = Path(data_dir)
-    jobs = [(s, c, e) for s in ROTATION_SETS for c in n_colors for e in exposures]
+    lights = tuple(positive_float("lights", v) for v in lights)
+    jobs = [
+        (s, c, e, li) for s in ROTATION_SETS for li in lights for c in n_colors for e in exposures
+    ]
     iterator = jobs
     if progress:
         from tqdm import tqdm
@@ -173,10 +229,10 @@ def run_real_rotation(
         iterator = tqdm(jobs, desc="real rotation", unit="run")
     loaded: dict[str, list[RotationPhoto]] = {}
     results = []
-    for set_name, c, exposure in iterator:
+    for set_name, c, exposure, light in iterator:
         if set_name not in loaded:
             loaded[set_name] = load_rotation_set(data_dir / set_name)
         cfg = CompassConfig(n_colors=c, exposure=exposure)
-        r = evaluate_rotation_set(loaded[set_name], cfg)
-        results.append({"set": set_name, "n_colors": c, "exposure": exposure, **r})
-    return {"experiment": "real_rotation", "data_dir": str(data_dir), "results": results}
+        r = evaluate_rotation_set(loaded[set_name], cfg, light=light)
+        results.append({"set": set_name, "n_colors": c, "exposure": exposure, "light": light, **r})
+    return {"experiment": "real_rotation", "results": results}
