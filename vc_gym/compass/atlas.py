@@ -143,50 +143,37 @@ class CompassAtlas:
         return len(self.names)
 
     def scores(
-        self,
-        image: np.ndarray,
-        camera: Camera,
-        spots: Sequence[int] | None = None,
-        gain: float | None = None,
+        self, image: np.ndarray, camera: Camera, spots: Sequence[int] | None = None
     ) -> tuple[np.ndarray, list[CompassEstimate]]:
         """Raw per-spot scores (mean log-probability per term) and estimates.
 
         ``spots`` (indices into :attr:`names`) scores only those spots' maps, in that
-        order; each equals its entry of the full answer bit for bit. ``gain``: the
-        session's light, as in :meth:`VisualCompass.log_likelihood`.
+        order; each equals its entry of the full answer bit for bit.
         """
-        return self._scores_of(
-            image, camera, self._spot_indices(spots), every=spots is None, gain=gain
-        )
+        return self._scores_of(image, camera, self._spot_indices(spots), every=spots is None)
 
     def _scores_of(
-        self,
-        image: np.ndarray,
-        camera: Camera,
-        which: np.ndarray,
-        every: bool,
-        gain: float | None = None,
+        self, image: np.ndarray, camera: Camera, which: np.ndarray, every: bool
     ) -> tuple[np.ndarray, list[CompassEstimate]]:
         """:meth:`scores` of the checked spot indices ``which`` (``every``: all of them,
         in order, so the stacked tables are read whole)."""
         compasses = [self.compasses[k] for k in which]
         first = compasses[0]
-        gain = first._checked_gain(gain)
-        per_map_light = first.config.exposure == "map" and gain is None
-        if not per_map_light and all(vc.colors is first.colors for vc in self.compasses):
+        if first.config.exposure != "map" and all(
+            vc.colors is first.colors for vc in self.compasses
+        ):
             # one colour set and config (the usual case): the image's sector features
             # are the same for every spot, so compute them once (not with
-            # exposure="map" and no session gain: every map then brings the frame to
-            # its own learned light)
+            # exposure="map": every map brings the frame to its own learned light)
             for vc in compasses:
                 vc._checked(image, camera, need_map=True)
-            features = first._sector_features(image, camera, gain or 1.0)
+            features = first._sector_features(image, camera)
             delta_t, base = self._stacked_tables()
             maps = None if every else which
             lls = _log_likelihoods_of(first.config, *features, delta_t, base, maps)
             ests = _estimates_of(compasses, *features, lls)
         else:
-            ests = [vc.estimate(image, camera, gain=gain) for vc in compasses]
+            ests = [vc.estimate(image, camera) for vc in compasses]
         return np.array([e.score for e in ests]), ests
 
     def _spot_indices(self, spots: Sequence[int] | None) -> np.ndarray:
@@ -287,11 +274,7 @@ class CompassAtlas:
         return (w * self._home_scores[:, which]).sum(axis=0) / w.sum(axis=0)
 
     def estimate_position(
-        self,
-        image: np.ndarray,
-        camera: Camera,
-        spots: Sequence[int] | None = None,
-        gain: float | None = None,
+        self, image: np.ndarray, camera: Camera, spots: Sequence[int] | None = None
     ) -> AtlasEstimate:
         """Position from the goodness of every spot (eq. 28-30).
 
@@ -302,8 +285,7 @@ class CompassAtlas:
         ``spots`` (indices into :attr:`names`) limits eq. 28-30 to those spots: only
         their maps are read (the cost grows with their number), and the estimate's
         dictionaries hold only them (a tracker can score only the few spots that fitted
-        best a moment ago). ``gain``: the session's light (atlases learned with
-        ``exposure="map"``; see :meth:`VisualCompass.log_likelihood`).
+        best a moment ago).
         """
         if any(not vc.is_learned for vc in self.compasses):
             missing = [
@@ -311,7 +293,7 @@ class CompassAtlas:
             ]
             raise NotLearnedError(f"spots without a learned map: {missing}")
         which = self._spot_indices(spots)
-        raw, ests = self._scores_of(image, camera, which, every=spots is None, gain=gain)
+        raw, ests = self._scores_of(image, camera, which, every=spots is None)
         rel = raw - self._home_scores_of(np.array([e.heading_deg for e in ests]), which)
         logw = self.sharpness * rel
         w = np.exp(logw - logw.max())

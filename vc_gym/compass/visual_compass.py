@@ -32,7 +32,7 @@ from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.exposure import gain_table, mean_linear_level
 from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
-from vc_gym.validation import finite_float, positive_float
+from vc_gym.validation import positive_float
 
 __all__ = ["VisualCompass", "CompassEstimate"]
 
@@ -498,17 +498,6 @@ class VisualCompass:
         total = counts.sum(axis=1)
         return counts, total
 
-    def _heading_gains(self, pixels: np.ndarray, geom: _Geometry) -> np.ndarray:
-        """Gain per candidate heading of the scanned ``pixels`` (:class:`LightMap`)."""
-        return self._light.heading_gains(
-            column_levels(pixels),
-            geom.first_col,
-            geom.stop_col,
-            geom.n_rel,
-            geom.heading_phase,
-            geom.roll_index[:, geom.heading_sector],
-        )
-
     def _light_profile(
         self, image: np.ndarray, camera: Camera
     ) -> tuple[np.ndarray, tuple[_Geometry, np.ndarray, np.ndarray], int]:
@@ -522,7 +511,15 @@ class VisualCompass:
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
         pixels = image[geom.row_slice, geom.col_slice]
-        steps = quantized_stops(self._heading_gains(pixels, geom))
+        gains = self._light.heading_gains(
+            column_levels(pixels),
+            geom.first_col,
+            geom.stop_col,
+            geom.n_rel,
+            geom.heading_phase,
+            geom.roll_index[:, geom.heading_sector],
+        )
+        steps = quantized_stops(gains)
         ll = np.empty(steps.size)
         features: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         for k in np.unique(steps).tolist():
@@ -586,30 +583,18 @@ class VisualCompass:
             return _estimates_of([self], *features, ll[None])[0]
         return self._estimate_of(*self._sector_features(image, camera, gain or 1.0))
 
-    def light_gain(
-        self, image: np.ndarray, camera: Camera, heading_deg: float | None = None
-    ) -> float:
+    def light_gain(self, image: np.ndarray, camera: Camera) -> float:
         """``exposure="map"``: the gain that brings this frame to the learned light.
 
-        Without ``heading_deg`` it is the gain of the heading that fits best when every
-        heading is scored with its own gain (see :meth:`log_likelihood`), in steps of a
-        third of a stop; that costs one classification per distinct gain. With a
-        heading known from elsewhere (a tracker's belief) it is the gain at that
-        heading, which costs no classification. One frame's answer is wrong when its
-        heading is; the median over the frames of a session is a robust estimate of
-        the session's light (pass it as ``gain``).
+        It is the gain of the heading that fits best when every heading is scored with
+        its own gain (see :meth:`log_likelihood`), in steps of a third of a stop. One
+        frame's answer is wrong when its best heading is; the median over the frames
+        of a session is a robust estimate of the session's light (pass it as ``gain``).
         """
         if self.config.exposure != "map":
             raise ValueError(f"light_gain needs exposure='map', not {self.config.exposure!r}")
         self._checked(image, camera, need_map=True)
-        if heading_deg is None:
-            return float(2.0 ** (self._light_profile(image, camera)[2] * GAIN_STEP_STOPS))
-        heading = finite_float("heading_deg", heading_deg)
-        i = int(round(heading / self.config.heading_step_deg)) % self._headings.size
-        h, w = image.shape[:2]
-        geom = self._geometry(camera, w, h)
-        gains = self._heading_gains(image[geom.row_slice, geom.col_slice], geom)
-        return float(gains[i])
+        return float(2.0 ** (self._light_profile(image, camera)[2] * GAIN_STEP_STOPS))
 
     def _checked_gain(self, gain: float | None) -> float | None:
         if gain is None:

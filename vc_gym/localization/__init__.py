@@ -29,7 +29,6 @@ callable; :func:`register_tracker` adds a name.
 
 from vc_gym.localization.grid import GridTracker
 from vc_gym.localization.kalman import KalmanTracker
-from vc_gym.localization.light import SessionLight
 from vc_gym.localization.particle import ParticleTracker
 from vc_gym.localization.position import AtlasPositionFilter
 from vc_gym.localization.protocol import Tracker, TrackerState
@@ -49,7 +48,6 @@ __all__ = [
     "GridTracker",
     "KalmanTracker",
     "ParticleTracker",
-    "SessionLight",
     "SpotShortlist",
     "Tracker",
     "TrackerSpec",

@@ -14,7 +14,7 @@ from vc_gym.localization.protocol import (
     check_reset_inputs,
 )
 from vc_gym.localization.sensors import CompassHeadingSensor, best_spot_heading_log_likelihood
-from vc_gym.localization.shortlist import SpotShortlist, light_heading
+from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["GridTracker"]
@@ -107,9 +107,7 @@ class GridTracker:
         )
         hf, pf = self.heading_filter, self.position_filter
         hf.predict(turn, noise_deg=self.motion_noise_deg + self.turn_noise * abs(turn))
-        est = self.spots.estimate(
-            self.atlas, image, self.camera, light_heading(self.atlas, hf.estimate, pan)
-        )
+        est = self.spots.estimate(self.atlas, image, self.camera)
         if self._heading_reader is not None:
             ll = self._heading_reader.heading_log_likelihood(image, hf.headings_deg, pan)
         else:

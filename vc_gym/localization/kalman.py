@@ -20,7 +20,7 @@ from vc_gym.localization.sensors import (
     best_spot_heading_log_likelihood,
     tempered_distribution,
 )
-from vc_gym.localization.shortlist import SpotShortlist, light_heading
+from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["KalmanTracker"]
@@ -114,9 +114,7 @@ class KalmanTracker:
         )
         kf, pf = self.heading_filter, self.position_filter
         kf.predict(turn, noise_deg=self.motion_noise_deg + self.turn_noise * abs(turn))
-        est = self.spots.estimate(
-            self.atlas, image, self.camera, light_heading(self.atlas, kf.estimate, pan)
-        )
+        est = self.spots.estimate(self.atlas, image, self.camera)
         ll = best_spot_heading_log_likelihood(self.atlas, est, self.headings_deg + pan)
         z = self._measurement(ll)
         if z is not None and math.isfinite(z[1]):

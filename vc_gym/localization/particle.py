@@ -17,7 +17,7 @@ from vc_gym.localization.sensors import (
     best_spot_heading_log_likelihood,
     tempered_distribution,
 )
-from vc_gym.localization.shortlist import SpotShortlist, light_heading
+from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.validation import nonnegative_float, positive_float
 
 __all__ = ["ParticleTracker"]
@@ -182,9 +182,7 @@ class ParticleTracker:
         pf.predict(
             (fwd, left, turn), (sf + 0.1 * abs(fwd), sl + 0.1 * abs(left), st + 0.1 * abs(turn))
         )
-        est = self.spots.estimate(
-            self.atlas, image, self.camera, light_heading(self.atlas, pf.estimate, pan)
-        )
+        est = self.spots.estimate(self.atlas, image, self.camera)
         if self._fresh:  # the first frame: every particle from the sensor
             pf.replace(np.arange(self.n_particles), self._sensor_poses(est, pan, self.n_particles))
             self._fresh = False
