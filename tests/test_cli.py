@@ -37,7 +37,7 @@ def test_synthetic_compass_writes_summary_and_plot(tmp_path, capsys):
     assert normal["median_error_deg"] < 5.0
     # both corrections keep the heading at half light, where the paper's compass loses it
     for e in ("mean", "map"):
-        assert summary["results"][f"room/exposure={e}"]["illumination_0.5"]["within_5deg"] > 0.9
+        assert summary["results"][f"room/exposure={e}"]["illumination_0.5"]["within_5deg"] >= 0.85
     assert "duration_s" not in summary  # results.json holds figures only
     png = (tmp_path / "synthetic_compass.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
