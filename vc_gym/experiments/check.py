@@ -294,6 +294,27 @@ def _bit_flips(tmp: Path) -> None:
     _load_bit_flipped(good, 40, lambda p: load_npz_checked(p, "vc_gym.Check", 1), tmp)
 
 
+def _map_light_tampered(tmp: Path) -> None:
+    """A map learned with ``exposure="map"`` whose light map is missing, negative or
+    brighter than white is refused; bit flips in it give only :class:`MapFileError`."""
+    pano = _panorama()
+    vc = VisualCompass(CompassConfig(exposure="map", n_colors=4))
+    vc.fit_colors([render_view(pano, Camera(yaw_deg=a)) for a in range(0, 360, 90)])
+    for a in range(0, 360, 45):
+        vc.learn(render_view(pano, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+    good = vc.save(tmp / "light.npz")
+    arrays = dict(np.load(good, allow_pickle=False))
+    for change, why in (
+        ({"light_sum": None}, "light_sum"),
+        ({"light_sum": -arrays["light_sum"]}, ">= 0"),
+        ({"light_sum": 2.0 * arrays["light_columns"]}, "exceeds"),
+    ):
+        bad = {k: v for k, v in {**arrays, **change}.items() if v is not None}
+        np.savez(tmp / "bad_light.npz", **bad)
+        _raises(MapFileError, why, lambda: VisualCompass.load(tmp / "bad_light.npz"))
+    _load_bit_flipped(good, 40, VisualCompass.load, tmp)
+
+
 def _renamed_npy(tmp: Path) -> None:
     np.save(tmp / "x.npy", np.zeros(3))
     (tmp / "x.npy").rename(tmp / "renamed.npz")
@@ -357,6 +378,7 @@ def _hostile_file_cases() -> list[Case]:
         Case("hostile_file", "npz: pickled object array", _object_array),
         Case("hostile_file", "npz: bit flips", _bit_flips),
         Case("hostile_file", "npz: a renamed .npy", _renamed_npy),
+        Case("hostile_file", "map: exposure='map' light map tampered", _map_light_tampered),
         Case("hostile_file", "npz: schema_version '1'", _text_version),
         Case("hostile_file", "map: deeply nested config JSON", _deep_map_config),
         Case("hostile_file", "model.zip: pickled payload", _hostile_model),
