@@ -224,6 +224,13 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                 f"decisions/s; efficiency {result['efficiency']:.2f} of "
                 f"{result['n_envs']} x the env's rate (target {result['target_efficiency']})"
             )
+            print(
+                f"in task-env steps: training {result['train_task_steps_per_s']:.1f}/s "
+                f"({result['train_task_steps_per_decision']:.2f} per decision), one env alone "
+                f"{result['env_task_steps_per_s']:.1f}/s "
+                f"({result['env_task_steps_per_decision']:.2f} per decision); efficiency "
+                f"{result['task_step_efficiency']:.2f}"
+            )
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:

@@ -75,9 +75,11 @@ def test_stop_action_holds_still_until_the_task_stops():
     assert terminated and info["stopped"] and info["success"]
     assert r == pytest.approx(10.0, abs=1e-3)  # the success bonus, summed over the hold
     assert info["still_time_s"] == pytest.approx(1.0)
+    assert info["task_steps"] == 10  # the whole 1 s stand at 10 Hz in one decision
     env.reset(seed=0, options={"pose": (1.0, 0.0, 180.0)})
     _, r, terminated, _, info = env.step(np.array([1.0, 0.0, -1.0], np.float32))
     assert not terminated and r > 0.2  # walked towards home (0.4 m/s for 0.1 s, from rest)
+    assert info["task_steps"] == 1
     assert r == pytest.approx(10.0 * (1.0 - info["home_error_m"]), abs=1e-6)
     with pytest.raises(ValueError):
         env.step(np.array([np.nan, 0.0, 0.0]))
@@ -113,7 +115,7 @@ def test_a_confirmed_stop_is_called_off_when_the_estimate_leaves_home():
     obs, _, terminated, truncated, info = env.step(stop)
     assert not terminated and not truncated
     assert np.hypot(*obs[HomingFeatures.HOME_VECTOR]) * HomingFeatures.METRES_SCALE > 0.25
-    assert info["still_time_s"] == pytest.approx(0.1)
+    assert info["still_time_s"] == pytest.approx(0.1) and info["task_steps"] == 1
     env.close()
 
 

@@ -50,6 +50,7 @@ def test_train_writes_model_config_and_log(trained):
     # the place was learned once, in the parent, and shared by both workers
     assert (out / "atlas.npz").is_file()
     assert summary["decisions_per_s"] > 0
+    assert summary["task_steps_per_s"] >= summary["decisions_per_s"]
 
 
 def test_train_writes_what_an_sb3_user_expects(trained):
@@ -122,6 +123,11 @@ def test_the_speed_benchmark_reports_training_next_to_the_env():
     assert r["env_decisions_per_s"] > 0 and r["train_decisions_per_s"] > 0
     assert r["efficiency"] == pytest.approx(
         r["train_decisions_per_s"] / r["env_decisions_per_s"], rel=0.01
+    )
+    # a decision is at least one task-env step (a stop that stands is many)
+    assert r["train_task_steps_per_decision"] >= 1.0 and r["env_task_steps_per_decision"] >= 1.0
+    assert r["task_step_efficiency"] == pytest.approx(
+        r["train_task_steps_per_s"] / r["env_task_steps_per_s"], rel=0.01
     )
 
 

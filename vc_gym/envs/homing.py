@@ -93,6 +93,10 @@ class StopAction(gym.Wrapper):
     ended, so that the policy decides again. An episode can then end by a stop only
     where the estimate stays within ``confirm_stop_m`` of home for the task's
     ``stop_time_s``. ``None`` (default): a stop is final.
+
+    Every step's ``info`` holds ``task_steps``: how many steps of the task env this
+    decision took (1 for a walk, up to the whole stand for a stop), so that a
+    decision's cost can be told from the env's step rate.
     """
 
     def __init__(
@@ -158,7 +162,10 @@ class StopAction(gym.Wrapper):
         a = np.clip(a, -1.0, 1.0)
         self._t += 1
         if a[2] <= STOP_THRESHOLD or self._t <= self.min_walk_steps:
-            return self.env.step(self._walk_action(max(a[0], 0.0), a[1]))
+            obs, r, terminated, truncated, info = self.env.step(
+                self._walk_action(max(a[0], 0.0), a[1])
+            )
+            return obs, r, terminated, truncated, {**info, "task_steps": 1}
         total = 0.0
         for i in range(self._max_hold):
             pan = self._pans[i % len(self._pans)]
@@ -166,7 +173,7 @@ class StopAction(gym.Wrapper):
             total += float(r)
             if terminated or truncated or self._left_home(obs):
                 break
-        return obs, total, terminated, truncated, info
+        return obs, total, terminated, truncated, {**info, "task_steps": i + 1}
 
     def _left_home(self, obs: np.ndarray) -> bool:
         """With ``confirm_stop_m``: the estimated home is farther than that (the stop is

@@ -8,6 +8,13 @@ learned once and shared) and reports its decisions per second while the policy t
 The env is measured before and after training (median of the rounds), in the same run.
 ``efficiency`` = training decisions/s ÷ (``n_envs`` × env decisions/s): 1 would mean the
 workers never wait for each other or for the policy.
+
+A decision is not a fixed amount of work: a stop that stands holds its decision for up
+to the whole stand (50 steps of the task env), and the policy stops more or less often
+as it learns. So the same is measured in steps of the task env
+(``StopAction``'s ``info["task_steps"]``): ``task_step_efficiency`` = training task
+steps/s ÷ (``n_envs`` × the env's task steps/s), with ``*_task_steps_per_decision``
+showing how much work a decision was in each.
 """
 
 from __future__ import annotations
@@ -26,18 +33,22 @@ from vc_gym.validation import int_at_least
 __all__ = ["bench_train"]
 
 
-def _env_rate(config: TrainConfig, run_dir: Path, steps: int, seed: int) -> float:
+def _env_rate(config: TrainConfig, run_dir: Path, steps: int, seed: int) -> tuple[float, float]:
+    """Decisions and task-env steps per second of one env with random actions."""
     env = training_env(config, run_dir)
     rng = np.random.default_rng(seed)
+    task_steps = 0
     try:
         env.reset(seed=seed)
         actions = rng.normal(0.0, 0.6, (steps, 3)).clip(-1, 1).astype(np.float32)
         t0 = time.perf_counter()
         for a in actions:  # like an untrained Gaussian policy (log_std_init -0.5)
-            _, _, terminated, truncated, _ = env.step(a)
+            _, _, terminated, truncated, info = env.step(a)
+            task_steps += int(info["task_steps"])
             if terminated or truncated:
                 env.reset()
-        return steps / (time.perf_counter() - t0)
+        seconds = time.perf_counter() - t0
+        return steps / seconds, task_steps / seconds
     finally:
         env.close()
 
@@ -68,8 +79,9 @@ def bench_train(
     Returns
     -------
     dict
-        ``env_decisions_per_s``, ``train_decisions_per_s``, ``n_envs``, ``efficiency``
-        and the settings.
+        ``env_decisions_per_s``, ``train_decisions_per_s``, ``n_envs``, ``efficiency``,
+        the same in task-env steps (``env_task_steps_per_s``,
+        ``train_task_steps_per_s``, ``task_step_efficiency``) and the settings.
     """
     int_at_least("env_steps", env_steps, 1)
     config = TrainConfig(  # no warm start: only the training's own speed is measured
@@ -81,14 +93,21 @@ def bench_train(
         before = _env_rate(config, Path(tmp), env_steps, seed)
         run = train(config, tmp, progress=progress)
         after = _env_rate(config, Path(tmp), env_steps, seed + 1)
-    env_rate = float(np.median([before, after]))
+    env_rate = float(np.median([before[0], after[0]]))
+    env_task_rate = float(np.median([before[1], after[1]]))
     train_rate = float(run["decisions_per_s"])
+    train_task_rate = float(run["task_steps_per_s"])
     return {
         "timesteps": timesteps,
         "n_envs": n_envs,
         "env_decisions_per_s": round(env_rate, 2),
-        "env_rounds_decisions_per_s": [round(before, 2), round(after, 2)],
+        "env_rounds_decisions_per_s": [round(before[0], 2), round(after[0], 2)],
         "train_decisions_per_s": round(train_rate, 2),
         "efficiency": round(train_rate / (n_envs * env_rate), 3),
         "target_efficiency": 0.7,
+        "env_task_steps_per_s": round(env_task_rate, 2),
+        "train_task_steps_per_s": round(train_task_rate, 2),
+        "task_step_efficiency": round(train_task_rate / (n_envs * env_task_rate), 3),
+        "env_task_steps_per_decision": round(env_task_rate / env_rate, 3),
+        "train_task_steps_per_decision": round(train_task_rate / train_rate, 3),
     }

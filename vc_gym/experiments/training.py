@@ -502,7 +502,7 @@ def train(
     model_path = out / "model.zip"
     write_atomic(model_path, model.save)
     recent = episodes[-50:]
-    rate = log.decisions_per_s
+    rate, task_rate = log.decisions_per_s, log.task_steps_per_s
     summary = {
         "model": str(model_path),
         "config": config.to_dict(),
@@ -510,6 +510,7 @@ def train(
         # agent decisions per second while the policy trained (no learning phase, no
         # worker start-up): what `vc-gym bench train` compares with the env's own speed
         "decisions_per_s": None if rate is None else round(rate, 2),
+        "task_steps_per_s": None if task_rate is None else round(task_rate, 2),
         "episodes": len(episodes),
         "resumed_from": None if checkpoint is None else str(checkpoint),
         "warm_start": warm_start,

@@ -44,6 +44,7 @@ class EpisodeLog(BaseCallback):
         self.on_checkpoint, self.label, self.progress = on_checkpoint, label, progress
         self.started = self.ended = 0.0
         self.first_timestep = 0
+        self.task_steps = 0  # steps of the task env behind the decisions (info "task_steps")
 
     def _on_training_start(self) -> None:
         self.started = time.perf_counter()
@@ -57,6 +58,7 @@ class EpisodeLog(BaseCallback):
 
     def _on_step(self) -> bool:
         self.bar.update(self.training_env.num_envs)
+        self.task_steps += sum(int(info.get("task_steps", 1)) for info in self.locals["infos"])
         for info in self.locals["infos"]:
             ep = info.get("episode")
             if ep is None:
@@ -89,6 +91,13 @@ class EpisodeLog(BaseCallback):
         seconds = self.ended - self.started
         done = int(self.model.num_timesteps) - self.first_timestep
         return done / seconds if seconds > 0 and done > 0 else None
+
+    @property
+    def task_steps_per_s(self) -> float | None:
+        """Steps of the task env per second behind those decisions (a stop that stands
+        holds its decision for many of them)."""
+        seconds = self.ended - self.started
+        return self.task_steps / seconds if seconds > 0 and self.task_steps > 0 else None
 
 
 class HeldOutEvaluation(EvalCallback):
