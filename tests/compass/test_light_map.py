@@ -159,3 +159,11 @@ def test_heading_gains_is_one_where_nothing_was_learned():
     # heading 0 sees sectors 0 (0.6) and 1 (0.15): (0.6*3 + 0.15*3) / (0.3*6) = 1.25
     # heading 1 sees 1 and 2 (unknown): 0.15 / 0.3; heading 2 nothing known; heading 3: 2.0
     np.testing.assert_allclose(gains(), [1.25, 0.5, 1.0, 2.0])
+
+
+def test_an_atlas_of_map_exposure_compasses_keeps_their_light(tmp_path, room_pano, map_compass):
+    atlas = CompassAtlas({"a": ((0.0, 0.0), map_compass)}, home="a")
+    loaded = CompassAtlas.load(atlas.save(tmp_path / "atlas.npz"))
+    np.testing.assert_array_equal(loaded.compasses[0]._light.columns, map_compass._light.columns)
+    img = render_view(room_pano, Camera(yaw_deg=300.0), illumination=0.5)
+    assert loaded.scores(img, Camera())[0][0] == atlas.scores(img, Camera())[0][0]
