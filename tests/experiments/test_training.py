@@ -255,6 +255,7 @@ def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
     returns = [r["runs"][k]["eval_final_mean_return"] for k in ("seed-0", "seed-1")]
     summary = r["over_seeds"]["eval_final_mean_return"]
     assert summary["n"] == 2 and summary["mean"] == pytest.approx(np.mean(returns), abs=1e-3)
+    assert summary["std"] == pytest.approx(np.std(returns, ddof=1), abs=1e-3)
     before = (out / "results.json").read_bytes()
     assert main(argv) == 0  # resumed: nothing trained again, the same figures
     assert (out / "results.json").read_bytes() == before

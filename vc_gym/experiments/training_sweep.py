@@ -79,7 +79,9 @@ def _mean_std(values: Sequence[float | None]) -> dict[str, float | None]:
     v = np.array([x for x in values if x is not None], dtype=np.float64)
     if v.size == 0:
         return {"mean": None, "std": None, "n": 0}
-    return {"mean": round(float(v.mean()), 4), "std": round(float(v.std()), 4), "n": int(v.size)}
+    # the sample std (ddof 1), as every other spread over seeds; 0 for one seed
+    std = float(v.std(ddof=1)) if v.size > 1 else 0.0
+    return {"mean": round(float(v.mean()), 4), "std": round(std, 4), "n": int(v.size)}
 
 
 def run_train_sweep(
@@ -92,7 +94,7 @@ def run_train_sweep(
     """Train ``config`` once per seed (``DIR/seed-<s>``) and summarise over the seeds.
 
     Returns the results written to ``results.json``: ``runs`` (each seed's figures)
-    and ``over_seeds`` (mean ± std of every :data:`FIGURES` entry, population std).
+    and ``over_seeds`` (mean ± sample std of every :data:`FIGURES` entry).
     """
     seeds = [int(s) for s in seeds]
     if not seeds or len(set(seeds)) != len(seeds) or min(seeds) < 0:
