@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
 from vc_gym.experiments.real_data import default_real_data_dir
 from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
 from vc_gym.worlds.room import Room, make_room, render_room_view
@@ -37,6 +37,25 @@ def learned_compass(pano: Panorama, config: CompassConfig | None = None) -> Visu
 def make_learned_compass():
     """The :func:`learned_compass` factory, for tests that need their own config."""
     return learned_compass
+
+
+def heading_errors(
+    vc: VisualCompass, pano: Panorama, yaws, illumination: float = 1.0, **cam_kwargs
+) -> np.ndarray:
+    """|heading error| (deg) of ``vc`` on views of ``pano`` at ``yaws`` (lit ×
+    ``illumination``; ``cam_kwargs`` such as ``pitch_deg`` for the camera)."""
+    errs = []
+    for yaw in yaws:
+        img = render_view(pano, Camera(yaw_deg=yaw, **cam_kwargs), illumination=illumination)
+        est = vc.estimate(img, Camera(**cam_kwargs))
+        errs.append(abs(wrap180(est.heading_deg - yaw)))
+    return np.array(errs)
+
+
+@pytest.fixture(scope="session")
+def view_heading_errors():
+    """The :func:`heading_errors` helper, for tests that measure a compass on views."""
+    return heading_errors
 
 
 @pytest.fixture(scope="session")

@@ -54,13 +54,12 @@ def test_light_gain_of_a_view_undoes_the_change_of_light(
 
 
 @pytest.mark.parametrize("illumination", [1.0, 0.5, 0.25])
-def test_map_exposure_finds_the_heading_in_changed_light(room_pano, map_compass, illumination):
+def test_map_exposure_finds_the_heading_in_changed_light(
+    room_pano, map_compass, illumination, view_heading_errors
+):
     yaws = np.random.default_rng(16).uniform(0.0, 360.0, 20)
-    errs = []
-    for yaw in yaws:
-        img = render_view(room_pano, Camera(yaw_deg=yaw), illumination=illumination)
-        errs.append(abs(wrap180(map_compass.estimate(img, Camera()).heading_deg - yaw)))
-    assert np.mean(np.array(errs) < 5.0) >= 0.9, np.round(errs, 1)
+    errs = view_heading_errors(map_compass, room_pano, yaws, illumination)
+    assert np.mean(errs < 5.0) >= 0.9, np.round(errs, 1)
 
 
 def test_a_known_session_gain_is_one_classification(room_pano, map_compass):
