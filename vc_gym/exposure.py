@@ -14,7 +14,14 @@ import math
 
 import numpy as np
 
-__all__ = ["SRGB_TO_LINEAR", "gain_table", "mean_linear_level", "quantized_gain"]
+__all__ = [
+    "MAX_GAIN_STOPS",
+    "SRGB_TO_LINEAR",
+    "column_levels",
+    "gain_table",
+    "mean_linear_level",
+    "quantized_gain",
+]
 
 _v = np.arange(256, dtype=np.float64) / 255.0
 #: Linear light (0..1) of every sRGB code value.
@@ -23,7 +30,8 @@ SRGB_TO_LINEAR.setflags(write=False)
 _LINEAR32 = SRGB_TO_LINEAR.astype(np.float32)
 #: Gains are quantised to 1/32 of a stop so that the tables can be cached.
 _STEPS_PER_STOP = 32
-_MAX_STOPS = 8
+#: Gains are kept within ±8 stops (a factor of 256).
+MAX_GAIN_STOPS = 8
 
 
 @functools.lru_cache(maxsize=512)
@@ -40,7 +48,7 @@ def quantized_gain(gain: float) -> int:
     """Index of the cached table nearest to ``gain`` (1/32-stop steps, ±8 stops)."""
     if not math.isfinite(gain) or gain <= 0:
         raise ValueError(f"gain must be finite and > 0, got {gain}")
-    stops = min(max(math.log2(gain), -_MAX_STOPS), _MAX_STOPS)
+    stops = min(max(math.log2(gain), -MAX_GAIN_STOPS), MAX_GAIN_STOPS)
     return int(round(stops * _STEPS_PER_STOP))
 
 
@@ -57,3 +65,10 @@ def mean_linear_level(pixels: np.ndarray) -> float:
     if pixels.size == 0:
         return 0.0
     return float(_LINEAR32[pixels].mean())
+
+
+def column_levels(pixels: np.ndarray) -> np.ndarray:
+    """Mean linear light (0..1) of every column of ``(R, U, 3)`` uint8 sRGB pixels."""
+    if pixels.shape[0] == 0:
+        return np.zeros(pixels.shape[1], dtype=np.float64)
+    return _LINEAR32[pixels].mean(axis=(0, 2), dtype=np.float64)

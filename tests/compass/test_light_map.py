@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, MapFileError, VisualCompass, wrap180
-from vc_gym.compass.light_map import GAIN_STEP_STOPS, LightMap, column_levels, quantized_stops
+from vc_gym.compass.light_map import GAIN_STEP_STOPS, LightMap, quantized_stops
+from vc_gym.exposure import column_levels
 from vc_gym.worlds.panorama import render_view
 
 MAP = CompassConfig(exposure="map")

@@ -14,28 +14,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from vc_gym.exposure import SRGB_TO_LINEAR
+from vc_gym.exposure import MAX_GAIN_STOPS
 
-__all__ = ["GAIN_STEP_STOPS", "LightMap", "column_levels", "quantized_stops"]
+__all__ = ["GAIN_STEP_STOPS", "LightMap", "quantized_stops"]
 
 #: Gains are tried in steps of a third of a stop (factor 1.26): finer steps cost a
 #: classification each and changed no result by more than the noise between steps.
 GAIN_STEP_STOPS = 1.0 / 3.0
-#: Gains are kept within ±8 stops (a factor of 256).
-_MAX_STOPS = 8.0
-_LINEAR32 = SRGB_TO_LINEAR.astype(np.float32)
-
-
-def column_levels(pixels: np.ndarray) -> np.ndarray:
-    """Mean linear light (0..1) of every column of scanned ``(R, U, 3)`` uint8 pixels."""
-    if pixels.shape[0] == 0:
-        return np.zeros(pixels.shape[1], dtype=np.float64)
-    return _LINEAR32[pixels].mean(axis=(0, 2), dtype=np.float64)
 
 
 def quantized_stops(gains: np.ndarray) -> np.ndarray:
-    """``gains`` as whole multiples of :data:`GAIN_STEP_STOPS` (ints, clipped to ±8 stops)."""
-    stops = np.clip(np.log2(gains), -_MAX_STOPS, _MAX_STOPS)
+    """``gains`` as whole multiples of :data:`GAIN_STEP_STOPS` (ints, clipped to ±8 stops,
+    :data:`~vc_gym.exposure.MAX_GAIN_STOPS`)."""
+    stops = np.clip(np.log2(gains), -MAX_GAIN_STOPS, MAX_GAIN_STOPS)
     return np.rint(stops / GAIN_STEP_STOPS).astype(np.int64)
 
 

@@ -27,9 +27,9 @@ from vc_gym.compass.features import (
     log2_bin,
     scan_grid,
 )
-from vc_gym.compass.light_map import GAIN_STEP_STOPS, LightMap, column_levels, quantized_stops
+from vc_gym.compass.light_map import GAIN_STEP_STOPS, LightMap, quantized_stops
 from vc_gym.errors import MapFileError, NotLearnedError
-from vc_gym.exposure import gain_table, mean_linear_level
+from vc_gym.exposure import column_levels, gain_table, mean_linear_level
 from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
