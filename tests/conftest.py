@@ -73,30 +73,36 @@ def synthetic_room() -> Room:
     return make_room(np.random.default_rng(3))
 
 
-@pytest.fixture(scope="session")
-def room_atlas(synthetic_room: Room) -> CompassAtlas:
-    """Compasses learned at ROOM_SPOTS in :func:`synthetic_room`, normalised at (0, 0)."""
+def learned_room_atlas(room: Room, config: CompassConfig | None = None) -> CompassAtlas:
+    """Compasses learned at ROOM_SPOTS in ``room``, normalised at (0, 0)."""
     colors = None
     spots = {}
     for name, (x, y) in ROOM_SPOTS.items():
-        vc = VisualCompass(CompassConfig(), colors)
+        vc = VisualCompass(config or CompassConfig(), colors)
         if colors is None:
             vc.fit_colors(
-                [
-                    render_room_view(synthetic_room, 0.0, 0.0, Camera(yaw_deg=a))
-                    for a in range(0, 360, 45)
-                ]
+                [render_room_view(room, 0.0, 0.0, Camera(yaw_deg=a)) for a in range(0, 360, 45)]
             )
             colors = vc.colors
         for a in LEARN_YAWS:
-            vc.learn(render_room_view(synthetic_room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+            vc.learn(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
         spots[name] = ((x, y), vc)
     atlas = CompassAtlas(spots, home="centre")
-    home = [
-        render_room_view(synthetic_room, 0.0, 0.0, Camera(yaw_deg=a)) for a in range(0, 360, 10)
-    ]
+    home = [render_room_view(room, 0.0, 0.0, Camera(yaw_deg=a)) for a in range(0, 360, 10)]
     atlas.normalize(home, [Camera()] * len(home))
     return atlas
+
+
+@pytest.fixture(scope="session")
+def room_atlas(synthetic_room: Room) -> CompassAtlas:
+    """The paper's compasses learned at ROOM_SPOTS in :func:`synthetic_room`."""
+    return learned_room_atlas(synthetic_room)
+
+
+@pytest.fixture(scope="session")
+def make_room_atlas():
+    """The :func:`learned_room_atlas` factory, for tests that need their own config."""
+    return learned_room_atlas
 
 
 @pytest.fixture(scope="session")

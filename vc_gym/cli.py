@@ -344,6 +344,7 @@ def _cmd_compass_experiment(args: argparse.Namespace) -> int:
                 parts = [
                     f"light×{k.split('_')[1]}: median {v['median_error_deg']:.2f}°, "
                     f"{v['within_5deg']:.0%} within 5°"
+                    + (f" (session gain {v['session_gain']:.2f})" if "session_gain" in v else "")
                     for k, v in entry.items()
                 ]
                 print(f"{label:28s} " + " | ".join(parts))

@@ -1,26 +1,32 @@
 """Exposure: scaling the light of an image in linear (not sRGB) units.
 
-Used to darken synthetic views physically (``illumination``) and, when
-``CompassConfig.exposure == "mean"``, to undo a change of illumination or camera
-exposure before colour classification: every frame's scanned pixels are scaled so
-that their mean linear luminance equals the reference level of the colour-fitting
-images. Both are one 256-entry table read per channel value.
+Used to darken synthetic views physically (``illumination``) and to undo a change of
+illumination or camera exposure before colour classification: with
+``CompassConfig.exposure == "mean"`` every frame's scanned pixels are scaled so that
+their mean linear luminance equals the reference level of the colour-fitting images;
+with ``"session"`` every frame of a session is scaled by one gain, the
+:class:`SessionLight` of the gains ``"mean"`` would apply. Both are one 256-entry
+table read per channel value.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+from collections import deque
 
 import numpy as np
 
 __all__ = [
+    "GAIN_STEP_STOPS",
     "MAX_GAIN_STOPS",
     "SRGB_TO_LINEAR",
+    "SessionLight",
     "column_levels",
     "gain_table",
     "mean_linear_level",
     "quantized_gain",
+    "quantized_stops",
 ]
 
 _v = np.arange(256, dtype=np.float64) / 255.0
@@ -32,6 +38,11 @@ _LINEAR32 = SRGB_TO_LINEAR.astype(np.float32)
 _STEPS_PER_STOP = 32
 #: Gains are kept within ±8 stops (a factor of 256).
 MAX_GAIN_STOPS = 8
+#: Gains the compass applies are whole multiples of a third of a stop (factor 1.26, a
+#: camera's exposure step): with ``exposure="map"`` each is a classification, and finer
+#: steps changed no result by more than the noise between steps; a session's light
+#: rounded to it does not wander with what the frames show.
+GAIN_STEP_STOPS = 1.0 / 3.0
 
 
 @functools.lru_cache(maxsize=512)
@@ -50,6 +61,13 @@ def quantized_gain(gain: float) -> int:
         raise ValueError(f"gain must be finite and > 0, got {gain}")
     stops = min(max(math.log2(gain), -MAX_GAIN_STOPS), MAX_GAIN_STOPS)
     return int(round(stops * _STEPS_PER_STOP))
+
+
+def quantized_stops(gains: np.ndarray) -> np.ndarray:
+    """``gains`` as whole multiples of :data:`GAIN_STEP_STOPS` (ints, clipped to ±8 stops,
+    :data:`MAX_GAIN_STOPS`)."""
+    stops = np.clip(np.log2(gains), -MAX_GAIN_STOPS, MAX_GAIN_STOPS)
+    return np.rint(stops / GAIN_STEP_STOPS).astype(np.int64)
 
 
 def gain_table(gain: float) -> np.ndarray:
@@ -72,3 +90,57 @@ def column_levels(pixels: np.ndarray) -> np.ndarray:
     if pixels.shape[0] == 0:
         return np.zeros(pixels.shape[1], dtype=np.float64)
     return _LINEAR32[pixels].mean(axis=(0, 2), dtype=np.float64)
+
+
+class SessionLight:
+    """The light of a session, read from the gains of its frames (beyond the paper).
+
+    The per-frame gain of ``exposure="mean"`` (reference level ÷ the frame's mean
+    level) reads the light from what a frame shows: a view of the sky or of a white
+    wall looks like more light, one of a dark shelf like less (one to two stops on the
+    real photo sets, where the light never changed). The light of a session changes
+    slowly, so the median of the last ``window`` frames' gains, in stops and rounded to
+    :data:`GAIN_STEP_STOPS`, reads the light and not the content: a session at the
+    colour-fitting light comes out at exactly 1 (the paper's classification), one at
+    half the light at 2.
+
+    Parameters
+    ----------
+    window : int or None
+        Frames the median runs over (the newest); ``None``: every frame since
+        :meth:`reset`.
+    """
+
+    def __init__(self, window: int | None = 100):
+        if window is not None and (
+            isinstance(window, bool) or not isinstance(window, (int, np.integer)) or window < 1
+        ):
+            raise ValueError(f"window must be an int >= 1 or None, got {window!r}")
+        self.window = None if window is None else int(window)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every frame (a new session)."""
+        self._stops: deque[float] = deque(maxlen=self.window)
+
+    def __len__(self) -> int:
+        return len(self._stops)
+
+    def update(self, frame_gain: float) -> float:
+        """Add one frame's gain and return the session's (:attr:`gain`).
+
+        A gain that is not a finite number > 0 (a black frame has no level to read) is
+        skipped: it says nothing about the light.
+        """
+        g = float(frame_gain)
+        if math.isfinite(g) and g > 0:
+            self._stops.append(min(max(math.log2(g), -MAX_GAIN_STOPS), MAX_GAIN_STOPS))
+        return self.gain
+
+    @property
+    def gain(self) -> float:
+        """The session's gain: 1 before any usable frame."""
+        if not self._stops:
+            return 1.0
+        steps = round(float(np.median(np.fromiter(self._stops, float))) / GAIN_STEP_STOPS)
+        return float(2.0 ** (steps * GAIN_STEP_STOPS))

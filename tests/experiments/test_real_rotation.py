@@ -44,16 +44,17 @@ def test_missing_folder_is_a_clear_error(tmp_path):
         load_rotation_set(tmp_path)
 
 
+@pytest.mark.parametrize("exposure", ["map", "session"])
 @pytest.mark.parametrize("set_name", ["rotation_grail", "rotation_parrington"])
-def test_map_exposure_finds_the_session_light_of_real_photos(real_data_dir, set_name):
+def test_session_exposures_find_the_session_light_of_real_photos(real_data_dir, set_name, exposure):
     """At the photos' own light the session gain is 1 and the paper's result is kept
     crop for crop; at half light it is 2 and the yaws are found (the paper's mode
     loses them: 36° and 68° median)."""
     photos = load_rotation_set(real_data_dir / set_name)
     paper = evaluate_rotation_set(photos, CompassConfig(n_colors=10))
-    full = evaluate_rotation_set(photos, CompassConfig(n_colors=10, exposure="map"))
+    full = evaluate_rotation_set(photos, CompassConfig(n_colors=10, exposure=exposure))
     assert full["session_gain"] == 1.0
     assert full["errors_deg"] == paper["errors_deg"]
-    half = evaluate_rotation_set(photos, CompassConfig(n_colors=10, exposure="map"), light=0.5)
+    half = evaluate_rotation_set(photos, CompassConfig(n_colors=10, exposure=exposure), light=0.5)
     assert half["session_gain"] == 2.0
     assert half["median_error_deg"] < 2.0 and half["within_10deg"] >= 0.75, half["errors_deg"]

@@ -25,6 +25,7 @@ from vc_gym.compass.visual_compass import (
     _log_likelihoods_of,
 )
 from vc_gym.errors import MapFileError, NotLearnedError
+from vc_gym.exposure import SessionLight
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
 
@@ -143,17 +144,33 @@ class CompassAtlas:
         return len(self.names)
 
     def scores(
-        self, image: np.ndarray, camera: Camera, spots: Sequence[int] | None = None
+        self,
+        image: np.ndarray,
+        camera: Camera,
+        spots: Sequence[int] | None = None,
+        gain: float | None = None,
     ) -> tuple[np.ndarray, list[CompassEstimate]]:
         """Raw per-spot scores (mean log-probability per term) and estimates.
 
         ``spots`` (indices into :attr:`names`) scores only those spots' maps, in that
-        order; each equals its entry of the full answer bit for bit.
+        order; each equals its entry of the full answer bit for bit. ``gain`` is the
+        session's light, as in :meth:`VisualCompass.log_likelihood`.
         """
-        return self._scores_of(image, camera, self._spot_indices(spots), every=spots is None)
+        which = self._spot_indices(spots)
+        return self._scores_of(image, camera, which, every=spots is None, gain=gain)
+
+    def frame_gain(self, image: np.ndarray, camera: Camera) -> float:
+        """:meth:`VisualCompass.frame_gain` of the first spot's map (an atlas' maps share
+        their colour classes and so their reference level)."""
+        return self.compasses[0].frame_gain(image, camera)
 
     def _scores_of(
-        self, image: np.ndarray, camera: Camera, which: np.ndarray, every: bool
+        self,
+        image: np.ndarray,
+        camera: Camera,
+        which: np.ndarray,
+        every: bool,
+        gain: float | None = None,
     ) -> tuple[np.ndarray, list[CompassEstimate]]:
         """:meth:`scores` of the checked spot indices ``which`` (``every``: all of them,
         in order, so the stacked tables are read whole)."""
@@ -167,13 +184,14 @@ class CompassAtlas:
             # exposure="map": every map brings the frame to its own learned light)
             for vc in compasses:
                 vc._checked(image, camera, need_map=True)
-            features = first._sector_features(image, camera)
+            g = first._gain_for(image, camera, first._checked_gain(gain))
+            features = first._sector_features(image, camera, g)
             delta_t, base = self._stacked_tables()
             maps = None if every else which
             lls = _log_likelihoods_of(first.config, *features, delta_t, base, maps)
             ests = _estimates_of(compasses, *features, lls)
         else:
-            ests = [vc.estimate(image, camera) for vc in compasses]
+            ests = [vc.estimate(image, camera, gain=gain) for vc in compasses]
         return np.array([e.score for e in ests]), ests
 
     def _spot_indices(self, spots: Sequence[int] | None) -> np.ndarray:
@@ -223,7 +241,8 @@ class CompassAtlas:
         Parameters
         ----------
         images, cameras : sequences of equal length
-            Frames taken at the home spot.
+            Frames taken at the home spot (with ``exposure="session"`` one session:
+        scored at its :class:`~vc_gym.exposure.SessionLight`).
         kernel_deg : float
             Angular width of the interpolation between home frames.
 
@@ -243,9 +262,15 @@ class CompassAtlas:
             )
         if not (math.isfinite(kernel_deg) and 0 < kernel_deg <= 360):
             raise ValueError(f"kernel_deg must be in (0, 360], got {kernel_deg}")
+        gain = None
+        if self.compasses[0].config.exposure == "session":  # the home frames: one session
+            light = SessionLight(window=None)
+            for img, cam in zip(images, cameras, strict=True):
+                light.update(self.frame_gain(img, cam))
+            gain = light.gain
         scores, headings = [], []
         for img, cam in zip(images, cameras, strict=True):
-            raw, ests = self.scores(img, cam)
+            raw, ests = self.scores(img, cam, gain=gain)
             scores.append(raw)
             headings.append([e.heading_deg for e in ests])
         self._home_scores = np.array(scores)  # (frames, spots)
@@ -274,7 +299,11 @@ class CompassAtlas:
         return (w * self._home_scores[:, which]).sum(axis=0) / w.sum(axis=0)
 
     def estimate_position(
-        self, image: np.ndarray, camera: Camera, spots: Sequence[int] | None = None
+        self,
+        image: np.ndarray,
+        camera: Camera,
+        spots: Sequence[int] | None = None,
+        gain: float | None = None,
     ) -> AtlasEstimate:
         """Position from the goodness of every spot (eq. 28-30).
 
@@ -285,7 +314,9 @@ class CompassAtlas:
         ``spots`` (indices into :attr:`names`) limits eq. 28-30 to those spots: only
         their maps are read (the cost grows with their number), and the estimate's
         dictionaries hold only them (a tracker can score only the few spots that fitted
-        best a moment ago).
+        best a moment ago). ``gain`` is the session's light, as in
+        :meth:`VisualCompass.log_likelihood` (a tracker keeps it, see
+        :class:`~vc_gym.exposure.SessionLight`).
         """
         if any(not vc.is_learned for vc in self.compasses):
             missing = [
@@ -293,7 +324,7 @@ class CompassAtlas:
             ]
             raise NotLearnedError(f"spots without a learned map: {missing}")
         which = self._spot_indices(spots)
-        raw, ests = self._scores_of(image, camera, which, every=spots is None)
+        raw, ests = self._scores_of(image, camera, which, every=spots is None, gain=gain)
         rel = raw - self._home_scores_of(np.array([e.heading_deg for e in ests]), which)
         logw = self.sharpness * rel
         w = np.exp(logw - logw.max())

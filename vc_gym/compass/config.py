@@ -10,7 +10,7 @@ from vc_gym.angles import MIN_HEADING_STEP_DEG, steps_in_circle
 __all__ = ["CompassConfig", "EXPOSURE_MODES", "MAX_MAP_ENTRIES", "MIN_COVERAGE"]
 
 #: Accepted values of :attr:`CompassConfig.exposure`.
-EXPOSURE_MODES = ("none", "mean", "map")
+EXPOSURE_MODES = ("none", "mean", "map", "session")
 #: Smallest scanning coverage (0.1 %); the paper reports that < 1 % still works.
 MIN_COVERAGE = 0.001
 #: Most counts a map may hold (``n_sectors · n_colors² · n_bins``; 128 MB as float64).
@@ -61,7 +61,13 @@ class CompassConfig:
         also learns the mean light of every sector and scores each candidate heading
         with the gain that brings the frame to the light learned in the directions
         it would then see (:mod:`vc_gym.compass.light_map`); it costs one
-        classification per distinct gain (about 5-15 per frame).
+        classification per distinct gain (about 5-15 per frame). ``"session"``
+        applies one gain to every frame of a session: the median of the frames'
+        ``"mean"`` gains, rounded to a third of a stop
+        (:class:`~vc_gym.exposure.SessionLight`, which the trackers keep), so a
+        session at the colour-fitting light is classified as the paper does and
+        one at half the light is brightened twice; a frame scored on its own is its
+        own session.
     """
 
     n_colors: int = 10

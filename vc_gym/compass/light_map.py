@@ -14,20 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from vc_gym.exposure import MAX_GAIN_STOPS
+from vc_gym.exposure import GAIN_STEP_STOPS, quantized_stops
 
+# the gain steps live in vc_gym.exposure (shared with SessionLight); named here too
 __all__ = ["GAIN_STEP_STOPS", "LightMap", "quantized_stops"]
-
-#: Gains are tried in steps of a third of a stop (factor 1.26): finer steps cost a
-#: classification each and changed no result by more than the noise between steps.
-GAIN_STEP_STOPS = 1.0 / 3.0
-
-
-def quantized_stops(gains: np.ndarray) -> np.ndarray:
-    """``gains`` as whole multiples of :data:`GAIN_STEP_STOPS` (ints, clipped to ±8 stops,
-    :data:`~vc_gym.exposure.MAX_GAIN_STOPS`)."""
-    stops = np.clip(np.log2(gains), -MAX_GAIN_STOPS, MAX_GAIN_STOPS)
-    return np.rint(stops / GAIN_STEP_STOPS).astype(np.int64)
 
 
 class LightMap:

@@ -7,6 +7,7 @@ camera image, a log-likelihood for every candidate heading (eq. 5, 15-16).
 
 from __future__ import annotations
 
+import math
 import os
 from collections import OrderedDict
 from collections.abc import Mapping, Sequence
@@ -27,9 +28,15 @@ from vc_gym.compass.features import (
     log2_bin,
     scan_grid,
 )
-from vc_gym.compass.light_map import GAIN_STEP_STOPS, LightMap, quantized_stops
+from vc_gym.compass.light_map import LightMap
 from vc_gym.errors import MapFileError, NotLearnedError
-from vc_gym.exposure import column_levels, gain_table, mean_linear_level
+from vc_gym.exposure import (
+    GAIN_STEP_STOPS,
+    column_levels,
+    gain_table,
+    mean_linear_level,
+    quantized_stops,
+)
 from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
@@ -233,12 +240,16 @@ class VisualCompass:
         if not images:
             raise ValueError("fit_colors needs at least one image")
         ref = 0.0
-        if self.config.exposure == "mean":
+        if self.config.exposure in ("mean", "session"):
             # reference level from the upper halves (what the compass scans at pitch 0)
             levels = [mean_linear_level(im[: max(im.shape[0] // 2, 1)]) for im in images]
             ref = float(np.mean(levels))
             if ref <= 0:
-                raise ValueError("exposure='mean' needs colour-fitting images that are not black")
+                raise ValueError(
+                    f"exposure={self.config.exposure!r} needs colour-fitting images that are "
+                    "not black"
+                )
+        if self.config.exposure == "mean":
             images = [
                 self._apply_gain(im[: max(im.shape[0] // 2, 1)], lvl, ref)
                 for im, lvl in zip(images, levels, strict=True)
@@ -542,9 +553,13 @@ class VisualCompass:
             Intrinsics and pitch of the camera; its ``yaw_deg`` is ignored.
         gain : float, optional
             Multiply the image's linear light by this before classifying it (a light
-            level known for the whole session, e.g. the median of :meth:`light_gain`
-            over its frames). Not with ``exposure="mean"``, which sets its own gain.
-            With ``exposure="map"`` the default is a gain per candidate heading.
+            level known for the whole session: a
+            :class:`~vc_gym.exposure.SessionLight` of :meth:`frame_gain` with
+            ``exposure="session"``, the median of :meth:`light_gain` with ``"map"``).
+            Not with ``exposure="mean"``, which sets its own gain. The default is 1,
+            except with ``"map"`` (a gain per candidate heading) and with
+            ``"session"`` (the frame's own :meth:`frame_gain`, rounded to a third of a
+            stop: a session of one frame).
 
         Returns
         -------
@@ -557,7 +572,9 @@ class VisualCompass:
         gain = self._checked_gain(gain)
         if gain is None and self.config.exposure == "map":
             return self._light_profile(image, camera)[0]
-        return self._log_likelihood_of(*self._sector_features(image, camera, gain or 1.0))
+        return self._log_likelihood_of(
+            *self._sector_features(image, camera, self._gain_for(image, camera, gain))
+        )
 
     def _log_likelihood_of(
         self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
@@ -581,7 +598,41 @@ class VisualCompass:
         if gain is None and self.config.exposure == "map":
             ll, features, _ = self._light_profile(image, camera)
             return _estimates_of([self], *features, ll[None])[0]
-        return self._estimate_of(*self._sector_features(image, camera, gain or 1.0))
+        return self._estimate_of(
+            *self._sector_features(image, camera, self._gain_for(image, camera, gain))
+        )
+
+    def frame_gain(self, image: np.ndarray, camera: Camera) -> float:
+        """The gain ``exposure="mean"`` applies to this frame (beyond the paper).
+
+        The reference level (the colour-fitting images') divided by the mean linear
+        level of the pixels the compass scans; ``inf`` for a black frame. One frame's
+        gain reads what it shows as much as the light; a
+        :class:`~vc_gym.exposure.SessionLight` over a session's frames reads the light.
+        Needs ``exposure="mean"`` or ``"session"``.
+        """
+        if self.config.exposure not in ("mean", "session"):
+            raise ValueError(
+                f"frame_gain needs exposure='mean' or 'session', not {self.config.exposure!r}"
+            )
+        self._checked(image, camera, need_map=False)
+        if self._colors is None:
+            raise NotLearnedError("call fit_colors() before frame_gain()")
+        h, w = image.shape[:2]
+        geom = self._geometry(camera, w, h)
+        level = mean_linear_level(image[geom.row_slice, geom.col_slice])
+        return self._exposure_ref / level if level > 0 else math.inf
+
+    def _gain_for(self, image: np.ndarray, camera: Camera, gain: float | None) -> float:
+        """The gain a checked ``gain`` argument means: itself, or without one 1, except
+        with ``exposure="session"``, where a frame without a session is its own: its
+        :meth:`frame_gain` rounded to :data:`~vc_gym.exposure.GAIN_STEP_STOPS`."""
+        if gain is not None:
+            return gain
+        if self.config.exposure == "session":
+            steps = quantized_stops(np.array(self.frame_gain(image, camera)))
+            return float(2.0 ** (int(steps) * GAIN_STEP_STOPS))
+        return 1.0
 
     def light_gain(self, image: np.ndarray, camera: Camera) -> float:
         """``exposure="map"``: the gain that brings this frame to the learned light.
@@ -736,8 +787,10 @@ class VisualCompass:
             or ref < 0
         ):
             raise MapFileError(f"{path}: entry 'exposure_reference' missing or invalid")
-        if stored.exposure == "mean" and ref <= 0:
-            raise MapFileError(f"{path}: exposure='mean' but no reference level stored")
+        if stored.exposure in ("mean", "session") and ref <= 0:
+            raise MapFileError(
+                f"{path}: exposure={stored.exposure!r} but no reference level stored"
+            )
         vc._exposure_ref = float(ref)
         sizes = arrays.get("learned_sizes")
         if (

@@ -21,10 +21,13 @@ import numpy as np
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassConfig, ImageCompass, VisualCompass
 from vc_gym.experiments.real_data import ROTATION_SETS, RotationPhoto, load_rotation_set
-from vc_gym.exposure import gain_table
+from vc_gym.exposure import SessionLight, gain_table
 from vc_gym.validation import positive_float
 
 __all__ = ["crop_columns", "evaluate_rotation_set", "rotation_set_errors", "run_real_rotation"]
+
+#: Exposure modes whose crops are also estimated at the light of the whole set.
+SESSION_EXPOSURES = ("map", "session")
 
 
 def crop_columns(photo: RotationPhoto, left: int, width: int) -> tuple[np.ndarray, Camera]:
@@ -78,9 +81,11 @@ def rotation_set_errors(
     light : float
         Linear light of the test crops relative to the photos (1: as taken).
     session_gain : bool
-        Estimate the light of the whole session first, as the median of the sensor's
-        per-crop :meth:`~vc_gym.compass.VisualCompass.light_gain`, then estimate
-        every crop with that gain (a visual compass with ``exposure="map"``).
+        Estimate the light of the whole session first, as the
+        :class:`~vc_gym.exposure.SessionLight` (median, in thirds of a stop) of the
+        sensor's per-crop :meth:`~vc_gym.compass.VisualCompass.light_gain`
+        (``exposure="map"``) or :meth:`~vc_gym.compass.VisualCompass.frame_gain`
+        (``exposure="session"``), then estimate every crop with that gain.
 
     Returns
     -------
@@ -92,8 +97,10 @@ def rotation_set_errors(
     if len(photos) < 4:
         raise ValueError(f"need at least 4 photos, got {len(photos)}")
     light = positive_float("light", light)
-    if session_gain and not (isinstance(sensor, VisualCompass) and sensor.config.exposure == "map"):
-        raise ValueError("session_gain needs a VisualCompass with exposure='map'")
+    if session_gain and not (
+        isinstance(sensor, VisualCompass) and sensor.config.exposure in SESSION_EXPOSURES
+    ):
+        raise ValueError(f"session_gain needs a VisualCompass with exposure in {SESSION_EXPOSURES}")
     train, test = photos[0::2], photos[1::2]
     frames = [
         (p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg)) for p in train
@@ -116,8 +123,11 @@ def rotation_set_errors(
     estimate = sensor.estimate
     if session_gain:
         assert isinstance(sensor, VisualCompass)
-        gains = [sensor.light_gain(crop, cam) for *_, crop, cam in tests]
-        gain = float(2.0 ** np.median(np.log2(gains)))
+        read = sensor.light_gain if sensor.config.exposure == "map" else sensor.frame_gain
+        session = SessionLight(window=None)
+        for *_, crop, cam in tests:
+            session.update(read(crop, cam))
+        gain = session.gain
         extra["gain"] = gain
 
         def estimate(image: np.ndarray, camera: Camera) -> Any:
@@ -158,10 +168,10 @@ def evaluate_rotation_set(
 ) -> dict[str, object]:
     """Learn from the even photos, estimate the yaw of crops of the odd ones.
 
-    With ``config.exposure == "map"`` the crops are estimated twice: each with its own
-    gain per candidate heading (``per_frame_*`` figures), and all with the session's
-    gain, the median of their :meth:`~vc_gym.compass.VisualCompass.light_gain` (the
-    main figures and ``session_gain``).
+    With ``config.exposure`` ``"map"`` or ``"session"`` the crops are estimated twice:
+    each on its own (``per_frame_*`` figures: with ``"map"`` a gain per candidate
+    heading, with ``"session"`` the crop's own gain), and all with the session's gain
+    (the main figures and ``session_gain``; see :func:`rotation_set_errors`).
 
     Returns
     -------
@@ -187,7 +197,8 @@ def evaluate_rotation_set(
         )
         return vc, r
 
-    vc, r = errors(session_gain=config.exposure == "map")
+    with_session = config.exposure in SESSION_EXPOSURES
+    vc, r = errors(session_gain=with_session)
     e = np.array(r["errors_deg"])
     out: dict[str, object] = {
         "median_error_deg": float(np.median(e)),
@@ -200,7 +211,7 @@ def evaluate_rotation_set(
         "errors_deg": [round(float(x), 3) for x in e],
         "crops": r["crops"],
     }
-    if config.exposure == "map":
+    if with_session:
         out["session_gain"] = r["gain"]
         per_frame = np.array(errors(session_gain=False)[1]["errors_deg"])
         out["per_frame_median_error_deg"] = float(np.median(per_frame))
@@ -211,7 +222,7 @@ def evaluate_rotation_set(
 def run_real_rotation(
     data_dir: str | os.PathLike,
     n_colors: tuple[int, ...] = (10, 3),
-    exposures: tuple[str, ...] = ("none", "mean", "map"),
+    exposures: tuple[str, ...] = ("none", "mean", "map", "session"),
     lights: tuple[float, ...] = (1.0, 0.5),
     progress: bool = False,
 ) -> dict[str, object]:

@@ -3,9 +3,11 @@
 Learns a room panorama the way the paper's robot does (8 body directions of 45°, each
 with head scanning, paper 4.3), then estimates the heading of random test frames at
 normal and at half illumination (paper 5.3), and writes ``results.json``
-and ``synthetic_compass.png``. Three exposure modes: none (the paper), ``mean`` (every
-frame scaled to the learned mean light) and ``map`` (every candidate heading scored with
-the gain that brings the frame to the light the map learned in that direction, per frame).
+and ``synthetic_compass.png``. Four exposure modes: none (the paper), ``mean`` (every
+frame scaled to the learned mean light), ``map`` (every candidate heading scored with
+the gain that brings the frame to the light the map learned in that direction, per frame)
+and ``session`` (the test frames of one light are one session, all scored at its
+:class:`~vc_gym.exposure.SessionLight`).
 """
 
 from __future__ import annotations
@@ -19,13 +21,14 @@ from tqdm import tqdm
 from vc_gym.angles import wrap180
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
 from vc_gym.experiments.output import new_figure, save_figure, write_json
+from vc_gym.exposure import SessionLight
 from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
 
 __all__ = ["run_synthetic_compass"]
 
 HEAD_PANS_DEG = (-22.5, 0.0, 22.5)
 BODY_YAWS_DEG = tuple(range(0, 360, 45))
-EXPOSURES = ("none", "mean", "map")
+EXPOSURES = ("none", "mean", "map", "session")
 
 
 def _learn(vc: VisualCompass, pano: Panorama, label: str) -> None:
@@ -37,13 +40,26 @@ def _learn(vc: VisualCompass, pano: Panorama, label: str) -> None:
 
 def _evaluate(
     vc: VisualCompass, pano: Panorama, yaws: np.ndarray, illumination: float, label: str
-) -> np.ndarray:
+) -> tuple[np.ndarray, float | None]:
+    """Signed heading errors of test frames at ``yaws``, and the session gain they were
+    scored at (``exposure="session"``; ``None`` otherwise)."""
     w, h = AIBO_RESOLUTION
+    images = [
+        render_view(pano, Camera(yaw_deg=float(yaw)), w, h, illumination=illumination)
+        for yaw in yaws
+    ]
+    gain = None
+    if vc.config.exposure == "session":
+        light = SessionLight(window=None)
+        for img in images:
+            light.update(vc.frame_gain(img, Camera()))
+        gain = light.gain
     errs = []
-    for yaw in tqdm(yaws, desc=f"localise {label}", unit="frame", leave=False):
-        img = render_view(pano, Camera(yaw_deg=float(yaw)), w, h, illumination=illumination)
-        errs.append(float(wrap180(vc.estimate(img, Camera()).heading_deg - yaw)))
-    return np.array(errs)
+    for yaw, img in tqdm(
+        list(zip(yaws, images, strict=True)), desc=f"localise {label}", unit="frame", leave=False
+    ):
+        errs.append(float(wrap180(vc.estimate(img, Camera(), gain=gain).heading_deg - yaw)))
+    return np.array(errs), gain
 
 
 def run_synthetic_compass(
@@ -73,12 +89,13 @@ def run_synthetic_compass(
             _learn(vc, pano, label)
             entry = {}
             for illum in (1.0, 0.5):
-                errs = _evaluate(vc, pano, yaws, illum, f"{label} light={illum}")
+                errs, gain = _evaluate(vc, pano, yaws, illum, f"{label} light={illum}")
                 a = np.abs(errs)
                 entry[f"illumination_{illum}"] = {
                     "median_error_deg": float(np.median(a)),
                     "within_5deg": float(np.mean(a < 5.0)),
                     "max_error_deg": float(a.max()),
+                    **({} if gain is None else {"session_gain": gain}),
                 }
                 curves[(kind, exposure, illum)] = (yaws, errs)
             results[label] = entry
