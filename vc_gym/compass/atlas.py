@@ -241,8 +241,8 @@ class CompassAtlas:
         Parameters
         ----------
         images, cameras : sequences of equal length
-            Frames taken at the home spot (with ``exposure="session"`` one session:
-        scored at its :class:`~vc_gym.exposure.SessionLight`).
+            Frames taken at the home spot (with ``exposure="session"`` one session,
+            scored at its :class:`~vc_gym.exposure.SessionLight`).
         kernel_deg : float
             Angular width of the interpolation between home frames.
 
