@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from vc_gym.exposure import GAIN_STEP_STOPS, MAX_GAIN_STOPS, SessionLight
+from vc_gym.exposure import GAIN_STEP_STOPS, MAX_GAIN_STOPS, SessionLight, rounded_gain
 
 
 def test_a_session_without_frames_is_at_the_fitting_light():
@@ -58,3 +58,18 @@ def test_impossible_windows_are_refused(window):
 
 def test_window_accepts_numpy_ints():
     assert SessionLight(np.int64(5)).window == 5
+
+
+def test_rounded_gain_is_a_whole_number_of_thirds_of_a_stop():
+    assert rounded_gain(1.1) == 1.0
+    assert rounded_gain(2.0**1.3) == pytest.approx(2.0 ** (4 * GAIN_STEP_STOPS))
+    assert rounded_gain(1e12) == pytest.approx(2.0**MAX_GAIN_STOPS)
+
+
+def test_a_whole_session_at_once_is_the_same_as_frame_by_frame():
+    gains = [2.2, 1.9, 0.7, 2.0, 8.0, float("inf")]
+    light = SessionLight(window=None)
+    for g in gains:
+        light.update(g)
+    assert SessionLight.of(gains) == light.gain == 2.0
+    assert SessionLight.of([]) == 1.0

@@ -27,6 +27,7 @@ __all__ = [
     "mean_linear_level",
     "quantized_gain",
     "quantized_stops",
+    "rounded_gain",
 ]
 
 _v = np.arange(256, dtype=np.float64) / 255.0
@@ -68,6 +69,11 @@ def quantized_stops(gains: np.ndarray) -> np.ndarray:
     :data:`MAX_GAIN_STOPS`)."""
     stops = np.clip(np.log2(gains), -MAX_GAIN_STOPS, MAX_GAIN_STOPS)
     return np.rint(stops / GAIN_STEP_STOPS).astype(np.int64)
+
+
+def rounded_gain(gain: float) -> float:
+    """``gain`` rounded to a whole number of :data:`GAIN_STEP_STOPS` (within ±8 stops)."""
+    return float(2.0 ** (int(quantized_stops(np.array(gain))) * GAIN_STEP_STOPS))
 
 
 def gain_table(gain: float) -> np.ndarray:
@@ -119,6 +125,14 @@ class SessionLight:
         self.window = None if window is None else int(window)
         self.reset()
 
+    @classmethod
+    def of(cls, frame_gains) -> float:
+        """The gain of one whole session given all its frames' gains at once."""
+        light = cls(window=None)
+        for g in frame_gains:
+            light.update(g)
+        return light.gain
+
     def reset(self) -> None:
         """Forget every frame (a new session)."""
         self._stops: deque[float] = deque(maxlen=self.window)
@@ -142,5 +156,4 @@ class SessionLight:
         """The session's gain: 1 before any usable frame."""
         if not self._stops:
             return 1.0
-        steps = round(float(np.median(np.fromiter(self._stops, float))) / GAIN_STEP_STOPS)
-        return float(2.0 ** (steps * GAIN_STEP_STOPS))
+        return rounded_gain(2.0 ** float(np.median(np.fromiter(self._stops, float))))

@@ -264,10 +264,8 @@ class CompassAtlas:
             raise ValueError(f"kernel_deg must be in (0, 360], got {kernel_deg}")
         gain = None
         if self.compasses[0].config.exposure == "session":  # the home frames: one session
-            light = SessionLight(window=None)
-            for img, cam in zip(images, cameras, strict=True):
-                light.update(self.frame_gain(img, cam))
-            gain = light.gain
+            pairs = zip(images, cameras, strict=True)
+            gain = SessionLight.of(self.frame_gain(img, cam) for img, cam in pairs)
         scores, headings = [], []
         for img, cam in zip(images, cameras, strict=True):
             raw, ests = self.scores(img, cam, gain=gain)

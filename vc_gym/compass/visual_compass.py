@@ -36,6 +36,7 @@ from vc_gym.exposure import (
     gain_table,
     mean_linear_level,
     quantized_stops,
+    rounded_gain,
 )
 from vc_gym.images import check_image
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
@@ -44,6 +45,8 @@ from vc_gym.validation import positive_float
 __all__ = ["VisualCompass", "CompassEstimate"]
 
 MAP_SCHEMA = "vc_gym.VisualCompass"
+#: Exposure modes that keep the colour-fitting images' mean light as a reference level.
+REFERENCE_EXPOSURES = ("mean", "session")
 MAP_SCHEMA_VERSION = 1
 #: Pseudo-count per bin of the heading-independent (pooled) histogram.
 _POOL_PSEUDOCOUNT = 0.5
@@ -240,7 +243,7 @@ class VisualCompass:
         if not images:
             raise ValueError("fit_colors needs at least one image")
         ref = 0.0
-        if self.config.exposure in ("mean", "session"):
+        if self.config.exposure in REFERENCE_EXPOSURES:
             # reference level from the upper halves (what the compass scans at pitch 0)
             levels = [mean_linear_level(im[: max(im.shape[0] // 2, 1)]) for im in images]
             ref = float(np.mean(levels))
@@ -611,7 +614,7 @@ class VisualCompass:
         :class:`~vc_gym.exposure.SessionLight` over a session's frames reads the light.
         Needs ``exposure="mean"`` or ``"session"``.
         """
-        if self.config.exposure not in ("mean", "session"):
+        if self.config.exposure not in REFERENCE_EXPOSURES:
             raise ValueError(
                 f"frame_gain needs exposure='mean' or 'session', not {self.config.exposure!r}"
             )
@@ -630,8 +633,7 @@ class VisualCompass:
         if gain is not None:
             return gain
         if self.config.exposure == "session":
-            steps = quantized_stops(np.array(self.frame_gain(image, camera)))
-            return float(2.0 ** (int(steps) * GAIN_STEP_STOPS))
+            return rounded_gain(self.frame_gain(image, camera))
         return 1.0
 
     def light_gain(self, image: np.ndarray, camera: Camera) -> float:
@@ -787,7 +789,7 @@ class VisualCompass:
             or ref < 0
         ):
             raise MapFileError(f"{path}: entry 'exposure_reference' missing or invalid")
-        if stored.exposure in ("mean", "session") and ref <= 0:
+        if stored.exposure in REFERENCE_EXPOSURES and ref <= 0:
             raise MapFileError(
                 f"{path}: exposure={stored.exposure!r} but no reference level stored"
             )

@@ -124,10 +124,7 @@ def rotation_set_errors(
     if session_gain:
         assert isinstance(sensor, VisualCompass)
         read = sensor.light_gain if sensor.config.exposure == "map" else sensor.frame_gain
-        session = SessionLight(window=None)
-        for *_, crop, cam in tests:
-            session.update(read(crop, cam))
-        gain = session.gain
+        gain = SessionLight.of(read(crop, cam) for *_, crop, cam in tests)
         extra["gain"] = gain
 
         def estimate(image: np.ndarray, camera: Camera) -> Any:

@@ -50,10 +50,7 @@ def _evaluate(
     ]
     gain = None
     if vc.config.exposure == "session":
-        light = SessionLight(window=None)
-        for img in images:
-            light.update(vc.frame_gain(img, Camera()))
-        gain = light.gain
+        gain = SessionLight.of(vc.frame_gain(img, Camera()) for img in images)
     errs = []
     for yaw, img in tqdm(
         list(zip(yaws, images, strict=True)), desc=f"localise {label}", unit="frame", leave=False
