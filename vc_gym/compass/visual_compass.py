@@ -450,6 +450,68 @@ class VisualCompass:
         self._tables = None
         return self
 
+    @property
+    def map_counts(self) -> np.ndarray:
+        """The map ``m[sector, i·c + j, bin]`` (eq. 6) as a read-only view.
+
+        Shape ``(n_sectors, n_colors², n_bins)``; ``float64`` counts of learned frames.
+        """
+        view = self._counts.view()
+        view.setflags(write=False)
+        return view
+
+    def sector_log_probabilities(self) -> np.ndarray:
+        """Smoothed ``log p(bin | sector, i→j)`` of the map (the terms of eq. 5, 16).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n_sectors, n_colors², n_bins)`` copy; every row sums to 1 in
+            probability. A sector never seen gives the pooled histograms of all sectors.
+        """
+        return self._log_tables()[2].copy()
+
+    def regrouped(self, target: np.ndarray) -> VisualCompass:
+        """A new compass whose sector ``t`` holds the map of every sector ``s`` with
+        ``target[s] == t`` (counts added; eq. 6 is a sum, so this is the map the same
+        frames would have given had each sector looked in direction ``t``).
+
+        This is how a map learned at one place is re-drawn for another
+        (:mod:`vc_gym.compass.parallax`): each sector moves to the direction its wall
+        point has from the new place. Sectors no source lands on stay unseen. Colours,
+        exposure reference, light map and frame count are kept.
+
+        Parameters
+        ----------
+        target : numpy.ndarray
+            ``(n_sectors,)`` integers in ``[0, n_sectors)``.
+
+        Raises
+        ------
+        ValueError
+            If ``target`` has another shape, is not integer or is out of range.
+        """
+        n = self.config.n_sectors
+        target = np.asarray(target)
+        if target.shape != (n,) or not np.issubdtype(target.dtype, np.integer):
+            raise ValueError(
+                f"target must be an integer array of shape ({n},), got "
+                f"{target.dtype} {target.shape}"
+            )
+        if target.min() < 0 or target.max() >= n:
+            raise ValueError(
+                f"target sectors must lie in [0, {n}), got {target.min()}..{target.max()}"
+            )
+        out = VisualCompass(self.config, self._colors)
+        out._exposure_ref = self._exposure_ref
+        np.add.at(out._counts, target, self._counts)
+        out._n_obs = np.bincount(target, weights=self._n_obs, minlength=n).astype(np.float64)
+        out._light.level_sum = np.bincount(target, weights=self._light.level_sum, minlength=n)
+        out._light.columns = np.bincount(target, weights=self._light.columns, minlength=n)
+        out._frames = self._frames
+        out._sizes = set(self._sizes)
+        return out
+
     # ------------------------------------------------------------------ likelihood
     def _log_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(delta_t, base, log_abs)`` for the current map (cached until it changes).
