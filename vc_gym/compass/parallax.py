@@ -29,6 +29,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from vc_gym.compass.camera import Camera
 from vc_gym.compass.visual_compass import VisualCompass
 
 __all__ = ["DEPTH_CANDIDATES_M", "ParallaxMap", "learn_depths", "sector_of"]
@@ -186,6 +187,7 @@ class ParallaxMap:
         self.depths_m = depths
         self._theta = np.radians((np.arange(n) + 0.5) * self.config.sector_deg)
         self._spot_wall = depths[:, None] * np.c_[np.cos(self._theta), np.sin(self._theta)]
+        self._centred: VisualCompass | None = None
 
     @classmethod
     def learn(
@@ -226,3 +228,49 @@ class ParallaxMap:
             moved = m.regrouped(sector_of(*(wall - pos).T, sd))
             out = moved if out is None else out.merge(moved)
         return out
+
+    def centred(self) -> VisualCompass:
+        """All parts re-drawn for the spot and added up (cached): every spot sector
+        takes, from each part, the sector in which that part saw the sector's wall
+        point (:meth:`VisualCompass.resampled`), so no sector is left unseen."""
+        if self._centred is None:
+            wall = self._spot_wall + self.spot
+            sd = self.config.sector_deg
+            out = None
+            for origin, m in self.parts:
+                moved = m.resampled(sector_of(*(wall - origin).T, sd))
+                out = moved if out is None else out.merge(moved)
+            self._centred = out
+        return self._centred
+
+    def sector_maps(self, positions: np.ndarray) -> np.ndarray:
+        """``(N, n_sectors)``: for a camera at each position, the spot sector that sees
+        the wall point of each direction sector (rows for
+        :meth:`VisualCompass.log_likelihood_remapped`)."""
+        pos = np.asarray(positions, dtype=np.float64)
+        if pos.ndim != 2 or pos.shape[1] != 2 or not np.all(np.isfinite(pos)):
+            raise ValueError(f"positions must be an (N, 2) array of finite metres, got {pos.shape}")
+        sd = self.config.sector_deg
+        return np.stack([sector_of(*(self.wall_points(p) - self.spot).T, sd) for p in pos])
+
+    def pose_log_likelihood(
+        self, image: np.ndarray, camera: Camera, positions: np.ndarray
+    ) -> np.ndarray:
+        """Log-likelihood of every (position, heading): the :meth:`centred` map with
+        each direction scored against the spot sector that sees the same wall point
+        from that position (eq. 5, 16 with the parallax of each position).
+
+        Parameters
+        ----------
+        image, camera
+            As for :meth:`VisualCompass.log_likelihood`.
+        positions : numpy.ndarray
+            ``(N, 2)`` candidate positions, world metres.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(N, n_headings)``; rows of different positions are comparable (the same
+            frame terms, each scored against one map sector).
+        """
+        return self.centred().log_likelihood_remapped(image, camera, self.sector_maps(positions))

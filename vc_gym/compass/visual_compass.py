@@ -471,6 +471,50 @@ class VisualCompass:
         """
         return self._log_tables()[2].copy()
 
+    def resampled(self, source: np.ndarray) -> VisualCompass:
+        """A new compass whose sector ``s`` holds a copy of the map of sector
+        ``source[s]`` (the inverse direction of :meth:`regrouped`: every sector gets
+        exactly one source, so none is left unseen).
+
+        :mod:`vc_gym.compass.parallax` uses it to re-draw a map learned elsewhere for
+        the spot (each spot sector takes the sector in which the other place saw the
+        same wall point). Colours, exposure reference and frame count are kept.
+
+        Raises
+        ------
+        ValueError
+            If ``source`` is not ``(n_sectors,)`` integers in ``[0, n_sectors)``.
+        """
+        source = self._checked_sectors("source", source)
+        out = self._like()
+        out._counts = self._counts[source]
+        out._n_obs = self._n_obs[source]
+        out._light.level_sum = self._light.level_sum[source]
+        out._light.columns = self._light.columns[source]
+        return out
+
+    def _checked_sectors(self, name: str, sectors: np.ndarray) -> np.ndarray:
+        n = self.config.n_sectors
+        sectors = np.asarray(sectors)
+        if sectors.shape != (n,) or not np.issubdtype(sectors.dtype, np.integer):
+            raise ValueError(
+                f"{name} must be an integer array of shape ({n},), got "
+                f"{sectors.dtype} {sectors.shape}"
+            )
+        if sectors.min() < 0 or sectors.max() >= n:
+            raise ValueError(
+                f"{name} sectors must lie in [0, {n}), got {sectors.min()}..{sectors.max()}"
+            )
+        return sectors
+
+    def _like(self) -> VisualCompass:
+        """An empty map with this one's config, colours, exposure, frames and sizes."""
+        out = VisualCompass(self.config, self._colors)
+        out._exposure_ref = self._exposure_ref
+        out._frames = self._frames
+        out._sizes = set(self._sizes)
+        return out
+
     def regrouped(self, target: np.ndarray) -> VisualCompass:
         """A new compass whose sector ``t`` holds the map of every sector ``s`` with
         ``target[s] == t`` (counts added; eq. 6 is a sum, so this is the map the same
@@ -492,24 +536,12 @@ class VisualCompass:
             If ``target`` has another shape, is not integer or is out of range.
         """
         n = self.config.n_sectors
-        target = np.asarray(target)
-        if target.shape != (n,) or not np.issubdtype(target.dtype, np.integer):
-            raise ValueError(
-                f"target must be an integer array of shape ({n},), got "
-                f"{target.dtype} {target.shape}"
-            )
-        if target.min() < 0 or target.max() >= n:
-            raise ValueError(
-                f"target sectors must lie in [0, {n}), got {target.min()}..{target.max()}"
-            )
-        out = VisualCompass(self.config, self._colors)
-        out._exposure_ref = self._exposure_ref
+        target = self._checked_sectors("target", target)
+        out = self._like()
         np.add.at(out._counts, target, self._counts)
         out._n_obs = np.bincount(target, weights=self._n_obs, minlength=n).astype(np.float64)
         out._light.level_sum = np.bincount(target, weights=self._light.level_sum, minlength=n)
         out._light.columns = np.bincount(target, weights=self._light.columns, minlength=n)
-        out._frames = self._frames
-        out._sizes = set(self._sizes)
         return out
 
     # ------------------------------------------------------------------ likelihood
@@ -649,6 +681,67 @@ class VisualCompass:
         return _log_likelihoods_of(
             self.config, geom, counts, total, delta_t[:, None, :], base[None]
         )[0]
+
+    def log_likelihood_remapped(
+        self,
+        image: np.ndarray,
+        camera: Camera,
+        sector_maps: np.ndarray,
+        gain: float | None = None,
+    ) -> np.ndarray:
+        """Log-likelihood over headings for each of several re-indexings of the map.
+
+        Row ``n`` of ``sector_maps`` says, for every direction sector ``s`` the camera
+        may look into, which sector of the map describes what it sees there; the
+        identity gives :meth:`log_likelihood` bit for bit. A map learned at one place
+        scores a camera at another this way, with each row the parallax of one
+        candidate position (:meth:`vc_gym.compass.parallax.ParallaxMap.pose_log_likelihood`).
+        The frame's features are extracted once; every further row costs one gather.
+
+        Parameters
+        ----------
+        image, camera, gain
+            As for :meth:`log_likelihood`; not with ``exposure="map"``, whose gain per
+            heading belongs to the map's own sectors.
+        sector_maps : numpy.ndarray
+            ``(N, n_sectors)`` integers in ``[0, n_sectors)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(N, n_headings)`` float64: row ``n`` is eq. 5, 16 with sector ``s`` of the
+            view scored against map sector ``sector_maps[n, s]``.
+        """
+        self._checked(image, camera, need_map=True)
+        if self.config.exposure == "map":
+            raise ValueError('log_likelihood_remapped does not support exposure="map"')
+        n_sec = self.config.n_sectors
+        remap = np.asarray(sector_maps)
+        if (
+            remap.ndim != 2
+            or remap.shape[1] != n_sec
+            or not np.issubdtype(remap.dtype, np.integer)
+            or (remap.size and (remap.min() < 0 or remap.max() >= n_sec))
+        ):
+            raise ValueError(
+                f"sector_maps must be an (N, {n_sec}) integer array of sectors in "
+                f"[0, {n_sec}), got {remap.dtype} {remap.shape}"
+            )
+        gain = self._checked_gain(gain)
+        geom, counts, total = self._sector_features(
+            image, camera, self._gain_for(image, camera, gain)
+        )
+        delta_t, base, _ = self._log_tables()
+        per_group = _group_scores(self.config, geom, counts, total, delta_t[:, None, :], base[None])
+        if per_group is None:
+            return np.zeros((remap.shape[0], geom.heading_phase.size))
+        idx = remap[:, geom.roll_index]  # (N, K, S): map sector of relative k at start s0
+        k = np.arange(geom.n_rel)[None, :, None]
+        by_start = per_group[:, k, 0, idx].sum(axis=2)  # (P, N, S)
+        ll = by_start[geom.heading_phase, :, geom.heading_sector].T  # (N, n_headings)
+        if self.config.temperature != 1.0:
+            ll = ll / self.config.temperature
+        return np.ascontiguousarray(ll)
 
     def estimate(
         self, image: np.ndarray, camera: Camera, gain: float | None = None
@@ -900,20 +993,10 @@ def _log_likelihoods_of(
     into ``M``) scores only those maps, reading only their tables. Returns
     ``(M, n_headings)`` (``(len(maps), n_headings)``); all zeros where nothing was seen.
     """
-    if maps is not None:
-        base = base[maps]
-    m = base.shape[0]
-    s_total = config.n_sectors
-    n = config.n_bins
-    seen = total > 0
-    if not seen.any():
+    m = base.shape[0] if maps is None else len(maps)
+    per_group = _group_scores(config, geom, counts, total, delta_t, base, maps)
+    if per_group is None:
         return np.zeros((m, geom.heading_phase.size))
-    nz_group, nz_code = np.nonzero(counts)
-    z = counts[nz_group, nz_code] / total[nz_group]
-    rows = nz_code * n + log2_bin(z, n)
-    per_group = _group_sums(delta_t, rows, nz_group, counts.shape[0], maps)
-    per_group[seen] += base[None, :, :]
-    per_group = per_group.reshape(-1, geom.n_rel, m, s_total)  # (P, K, M, S) by sector
     # score[p, m, s0] = sum_k per_group[p, k, m, s0 + k + kmin]; the advanced indices
     # come first: (K, S, P, M), summed over K
     by_start = per_group[:, np.arange(geom.n_rel)[:, None], :, geom.roll_index].sum(axis=0)
@@ -921,6 +1004,33 @@ def _log_likelihoods_of(
     if config.temperature != 1.0:
         ll = ll / config.temperature
     return np.ascontiguousarray(ll)
+
+
+def _group_scores(
+    config: CompassConfig,
+    geom: _Geometry,
+    counts: np.ndarray,
+    total: np.ndarray,
+    delta_t: np.ndarray,
+    base: np.ndarray,
+    maps: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """``(P, K, M, S)``: the log-ratio of the frame's columns of phase ``p`` and relative
+    sector ``k`` under sector ``s`` of map ``m`` (see :func:`_log_likelihoods_of`);
+    ``None`` if the frame saw nothing."""
+    if maps is not None:
+        base = base[maps]
+    m = base.shape[0]
+    n = config.n_bins
+    seen = total > 0
+    if not seen.any():
+        return None
+    nz_group, nz_code = np.nonzero(counts)
+    z = counts[nz_group, nz_code] / total[nz_group]
+    rows = nz_code * n + log2_bin(z, n)
+    per_group = _group_sums(delta_t, rows, nz_group, counts.shape[0], maps)
+    per_group[seen] += base[None, :, :]
+    return per_group.reshape(-1, geom.n_rel, m, config.n_sectors)
 
 
 def _group_sums(
