@@ -17,7 +17,15 @@ pose, head scanning) the heading is read from likelihoods summed over its frames
 
 The robot's position is the true one plus Gaussian noise of ``--noise`` metres per axis.
 
+``--joint K`` instead asks whether the views themselves tell the position: the pose
+likelihood (:meth:`~vc_gym.compass.parallax.ParallaxMap.pose_log_likelihood`, each
+spot's map centred with its turns around) of the K spots nearest the view, summed over
+the view's frames and over the spots, on positions 0.1 m apart within 0.6 m of the
+nearest spot; the heading and position of its maximum, and for comparison the heading at
+the true position; ``--ray-depths`` uses the ray-cast distances instead of the learned.
+
     python scripts/parallax_diagnostic.py office --noise 0 0.2 0.4
+    python scripts/parallax_diagnostic.py office --joint 1 2 4
 """
 
 from __future__ import annotations
@@ -40,13 +48,16 @@ from vc_gym.experiments.views import field_grid, learning_turn, look, view_poses
 EYE_HEIGHT_M = 0.30
 
 
-def atlas(scene: str, around_m: float, cache: Path, seed: int) -> CompassAtlas:
+def atlas(
+    scene: str, around_m: float, cache: Path, seed: int, exposure: str = "mean"
+) -> CompassAtlas:
     """The improved mode's atlas (exposure="mean"), with or without the turns around."""
     spots = training_spots(scene_field_bounds(scene), "improved")
     spec = atlas_spec(
-        scene, seed, "grid", 5.0, {"exposure": "mean"}, spots=spots, around_m=around_m
+        scene, seed, "grid", 5.0, {"exposure": exposure}, spots=spots, around_m=around_m
     )
-    path = cache / f"{scene}-seed{seed}-around{around_m}.npz"
+    tag = "" if exposure == "mean" else f"-{exposure}"
+    path = cache / f"{scene}-seed{seed}-around{around_m}{tag}.npz"
     if not path.exists():
         learn_atlas_job(spec, str(path))
     return CompassAtlas.load(path)
@@ -79,10 +90,12 @@ def main() -> None:
     ap.add_argument("--noise", type=float, nargs="+", default=[0.0, 0.2, 0.4])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--cache", type=Path, default=Path("parallax_cache"))
+    ap.add_argument("--joint", type=int, nargs="+", default=[], metavar="K")
+    ap.add_argument("--ray-depths", action="store_true", help="--joint with the ray-cast distances")
     args = ap.parse_args()
     args.cache.mkdir(parents=True, exist_ok=True)
-    merged = atlas(args.scene, GRID_AROUND_M, args.cache, args.seed)
-    alone = atlas(args.scene, 0.0, args.cache, args.seed)
+    merged = atlas(args.scene, GRID_AROUND_M, args.cache, args.seed, args.exposure)
+    alone = atlas(args.scene, 0.0, args.cache, args.seed, args.exposure)
     env = AiboRoomEnv(scene=args.scene)
     env.reset(seed=args.seed)
     cam = Camera(hfov_deg=env.camera.hfov_deg)
@@ -114,6 +127,13 @@ def main() -> None:
     poses = view_poses(grid, 2, np.random.default_rng([args.seed, 51]))
     views = [look(env, tuple(p), 10, seed=1000 + k) for k, p in enumerate(poses)]
     headings = np.arange(360.0)
+    if args.joint:
+        if args.ray_depths:
+            each = [
+                ParallaxMap(e.spot, r.depths_m, e.parts) for e, r in zip(each, ray, strict=True)
+            ]
+        joint(args.scene, poses, views, spots, each, cam, args.joint)
+        return
     for noise in args.noise:
         rng = np.random.default_rng(99)
         errors: dict[str, list[float]] = {}
@@ -136,6 +156,37 @@ def main() -> None:
                 f"  noise {noise:.1f} m  {name:24s} mean {np.mean(e):5.2f}°, "
                 f"median {np.median(e):5.2f}° ({len(e)} views)"
             )
+
+
+def joint(scene, poses, views, spots, each, cam, ks) -> None:
+    """Heading and position from the pose likelihood of the K nearest spots' maps."""
+    step = np.arange(-0.6, 0.6 + 1e-9, 0.1)
+    offsets = np.stack(np.meshgrid(step, step, indexing="ij"), axis=-1).reshape(-1, 2)
+    headings = np.arange(360.0)
+    errors: dict[str, list[float]] = {}
+    for pose, seen in zip(poses, views, strict=True):
+        order = np.argsort(np.hypot(spots[:, 0] - pose[0], spots[:, 1] - pose[1]))
+        cand = spots[order[0]] + offsets
+        total = np.zeros((len(cand), 360))
+        at_true = np.zeros(360)
+        for k in range(max(ks)):
+            pm = each[order[k]]
+            rows = pm.sector_maps(np.vstack([cand, pose[None, :2]]))
+            for img, pan, _ in seen:
+                ll = pm.centred().log_likelihood_remapped(img, cam, rows)
+                ll = interp_circular(ll, 1.0, headings + pan)
+                total += ll[:-1]
+                at_true += ll[-1]
+            if k + 1 in ks:
+                n, h = np.unravel_index(np.argmax(total), total.shape)
+                for name, value in [
+                    ("heading at the best pose", abs(wrap180(h - pose[2]))),
+                    ("position error of it (m)", float(np.hypot(*(cand[n] - pose[:2])))),
+                    ("heading at the true position", abs(wrap180(np.argmax(at_true) - pose[2]))),
+                ]:
+                    errors.setdefault(f"K={k + 1} {name}", []).append(value)
+    for name, e in errors.items():
+        print(f"  {scene} {name:36s} mean {np.mean(e):5.2f}, median {np.median(e):5.2f}")
 
 
 if __name__ == "__main__":

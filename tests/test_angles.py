@@ -5,7 +5,14 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from vc_gym.angles import circular_mean, circular_std, circular_std_rows, wrap180, wrap360
+from vc_gym.angles import (
+    circular_mean,
+    circular_std,
+    circular_std_rows,
+    interp_circular,
+    wrap180,
+    wrap360,
+)
 
 angles = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False)
 
@@ -92,3 +99,24 @@ def test_steps_in_circle_refuses_what_is_not_a_step(bad):
 
     with pytest.raises(ValueError, match="step_deg"):
         steps_in_circle(bad)
+
+
+def test_interp_circular_is_exact_on_the_grid_linear_between_and_wraps():
+    values = np.array([0.0, 10.0, 20.0, 30.0])  # at 0, 90, 180, 270 degrees
+    got = interp_circular(values, 90.0, [0.0, 90.0, 45.0, 315.0, 360.0, -45.0, 720.0 + 135.0])
+    np.testing.assert_allclose(got, [0.0, 10.0, 5.0, 15.0, 0.0, 15.0, 15.0])
+
+
+def test_interp_circular_keeps_ruled_out_headings_out():
+    values = np.array([0.0, -np.inf, 2.0, 3.0])
+    got = interp_circular(values, 90.0, [0.0, 45.0, 180.0])
+    assert got[0] == 0.0 and got[1] == -np.inf and got[2] == 2.0
+
+
+def test_interp_circular_rows_equal_one_row_at_a_time():
+    rows = np.random.default_rng(0).normal(size=(3, 360))
+    query = np.array([0.25, 17.5, 359.9, -3.3])
+    got = interp_circular(rows, 1.0, query)
+    assert got.shape == (3, 4)
+    for r in range(3):
+        np.testing.assert_array_equal(got[r], interp_circular(rows[r], 1.0, query))

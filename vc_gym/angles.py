@@ -186,7 +186,8 @@ def interp_circular(values: np.ndarray, step_deg: float, query_deg: ArrayLike) -
     Parameters
     ----------
     values : numpy.ndarray
-        ``(n,)`` samples at ``0, step, ..., (n - 1) step`` degrees.
+        ``(n,)`` samples at ``0, step, ..., (n - 1) step`` degrees, or ``(..., n)``: one
+        such function per row, all interpolated at the same queries.
     step_deg : float
         Grid step in degrees (``n * step_deg == 360``).
     query_deg : array_like
@@ -195,13 +196,14 @@ def interp_circular(values: np.ndarray, step_deg: float, query_deg: ArrayLike) -
     Returns
     -------
     numpy.ndarray
-        Interpolated values, shaped like ``query_deg``.
+        Interpolated values, shaped like ``query_deg`` (``values.shape[:-1] +
+        query_deg.shape`` for several rows).
     """
-    n = values.size
+    n = values.shape[-1]
     pos = np.mod(np.asarray(query_deg, dtype=np.float64), 360.0) / step_deg
     i0 = np.floor(pos).astype(np.int64)
     frac = pos - i0
-    a = values[i0 % n]
-    b = values[(i0 + 1) % n]
+    a = values[..., i0 % n]
+    b = values[..., (i0 + 1) % n]
     with np.errstate(invalid="ignore"):
         return np.where(frac == 0.0, a, (1.0 - frac) * a + frac * b)
