@@ -234,3 +234,28 @@ def test_pose_likelihood_gives_the_heading_at_the_position(room, turns, pos):
         total += np.roll(pm.pose_log_likelihood(img, Camera(), [pos, (0.0, 0.0)]), -pan, axis=1)
     assert abs(wrap180(np.argmax(total[0]) - yaw)) <= 2.0
     assert total[0].max() > total[1].max()
+
+
+def test_pose_likelihood_finds_the_position_in_the_ray_cast_room(room, turns):
+    """Ten frames looking one way, head scanning: the best of 13 x 13 positions 0.1 m
+    apart is near the truth (README: 0.13 m median over 20 views in this room)."""
+    spot, around = turns
+    pm = ParallaxMap.learn((0.0, 0.0), spot, around)
+    step = np.arange(-0.6, 0.61, 0.1)
+    cand = np.stack(np.meshgrid(step, step, indexing="ij"), axis=-1).reshape(-1, 2)
+    rows = pm.sector_maps(cand)
+    rng = np.random.default_rng(11)
+    position_errors, heading_errors = [], []
+    for _ in range(8):
+        r, a = rng.uniform(0.2, 0.6), rng.uniform(0.0, 2 * np.pi)
+        pos, yaw = (r * np.cos(a), r * np.sin(a)), rng.uniform(0.0, 360.0)
+        total = np.zeros((len(cand), 360))
+        for pan in (-20, 0, 20, 40, 20, 0, -20, 0, 20, 40):
+            img = render_room_view(room, *pos, Camera(yaw_deg=yaw + pan))
+            ll = pm.centred().log_likelihood_remapped(img, Camera(), rows)
+            total += np.roll(ll, -pan, axis=1)
+        n, h = np.unravel_index(np.argmax(total), total.shape)
+        position_errors.append(np.hypot(*(cand[n] - pos)))
+        heading_errors.append(abs(wrap180(h - yaw)))
+    assert np.median(position_errors) <= 0.2
+    assert np.mean(heading_errors) < 5.0
