@@ -14,6 +14,7 @@ from vc_gym.compass.camera import AIBO_HFOV_DEG, AIBO_RESOLUTION, Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.features import log2_bin
+from vc_gym.compass.parallax import ParallaxMap, learn_depths
 from vc_gym.compass.protocol import ImageCompass
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
 from vc_gym.errors import MapFileError, NotLearnedError
@@ -30,9 +31,11 @@ __all__ = [
     "ImageCompass",
     "MapFileError",
     "NotLearnedError",
+    "ParallaxMap",
     "VisualCompass",
     "circular_mean",
     "circular_std",
+    "learn_depths",
     "log2_bin",
     "wrap180",
     "wrap360",
