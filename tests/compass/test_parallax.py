@@ -259,3 +259,13 @@ def test_pose_likelihood_finds_the_position_in_the_ray_cast_room(room, turns):
         heading_errors.append(abs(wrap180(h - yaw)))
     assert np.median(position_errors) <= 0.2
     assert np.mean(heading_errors) < 5.0
+
+
+def test_maps_of_other_colour_classes_cannot_join(room, turns):
+    spot, around = turns
+    stranger = _turn(room, 0.5, 0.0)  # its own colour classes, fitted there
+    assert not stranger.shares_colors(spot) and around[0][1].shares_colors(spot)
+    with pytest.raises(ValueError, match="colour classes"):
+        learn_depths(spot, [((0.5, 0.0), stranger)])
+    with pytest.raises(ValueError, match="colour classes"):
+        ParallaxMap((0, 0), np.ones(80), [((0, 0), spot), ((0.5, 0), stranger)])

@@ -73,6 +73,8 @@ def _checked_maps(
             raise ValueError(f"{what}[{k}]: the map must be a learned VisualCompass")
         if m.config != like.config:
             raise ValueError(f"{what}[{k}]: the map has another CompassConfig")
+        if not m.shares_colors(like):
+            raise ValueError(f"{what}[{k}]: the map was learned with other colour classes")
         out.append((_point(f"{what}[{k}] position", point), m))
     if not out:
         raise ValueError(f"{what} must hold at least one map")

@@ -436,11 +436,7 @@ class VisualCompass:
             raise ValueError(f"can only merge a VisualCompass, got {type(other).__name__}")
         if other.config != self.config:
             raise ValueError("cannot merge maps learned with different CompassConfigs")
-        if (
-            self._colors is None
-            or other._colors is None
-            or not _same_colors(self._colors, other._colors)
-        ):
+        if not self.shares_colors(other):
             raise ValueError("cannot merge maps learned with different colour classes")
         self._counts += other._counts
         self._n_obs += other._n_obs
@@ -449,6 +445,15 @@ class VisualCompass:
         self._sizes |= other._sizes
         self._tables = None
         return self
+
+    def shares_colors(self, other: VisualCompass) -> bool:
+        """True if both compasses classify pixels with the same colour classes (then
+        their maps count the same transitions and may be added or compared)."""
+        return (
+            self._colors is not None
+            and other._colors is not None
+            and _same_colors(self._colors, other._colors)
+        )
 
     @property
     def map_counts(self) -> np.ndarray:
