@@ -87,6 +87,15 @@ def _learned(spot_map: VisualCompass) -> VisualCompass:
     return spot_map
 
 
+def _added(maps) -> VisualCompass:
+    """The sum of an iterable of fresh maps (the others are merged into the first)."""
+    maps = iter(maps)
+    out = next(maps)
+    for m in maps:
+        out.merge(m)
+    return out
+
+
 def learn_depths(
     spot_map: VisualCompass,
     around: Sequence[tuple[Sequence[float], VisualCompass]],
@@ -208,13 +217,19 @@ class ParallaxMap:
 
     def wall_points(self, position: Sequence[float]) -> np.ndarray:
         """``(n_sectors, 2)`` world points the sector centres look at from ``position``."""
-        p = _point("position", position) - self.spot
+        return self._walls(_point("position", position)[None])[0]
+
+    def _walls(self, positions: np.ndarray) -> np.ndarray:
+        """``(N, n_sectors, 2)`` :meth:`wall_points` of ``(N, 2)`` checked positions."""
+        p = (positions - self.spot)[:, None, :]  # (N, 1, 2)
         d, th, sd = self.depths_m, self._theta, self.config.sector_deg
-        r = d.copy()
+        ray = np.c_[np.cos(th), np.sin(th)]  # (S, 2)
+        r = np.broadcast_to(d, (len(positions), d.size))
         for _ in range(_RAY_ITERATIONS):  # the spot's distance towards the point hit
-            s = sector_of(p[0] + r * np.cos(th), p[1] + r * np.sin(th), sd)
-            r = np.maximum(np.hypot(*(self._spot_wall[s] - p).T), _MIN_RANGE_M)
-        return self.spot + p + r[:, None] * np.c_[np.cos(th), np.sin(th)]
+            hit = p + r[..., None] * ray
+            s = sector_of(hit[..., 0], hit[..., 1], sd)
+            r = np.maximum(np.hypot(*np.moveaxis(self._spot_wall[s] - p, -1, 0)), _MIN_RANGE_M)
+        return self.spot + p + r[..., None] * ray
 
     def at(self, position: Sequence[float]) -> VisualCompass:
         """The map re-drawn for a robot standing at ``position`` (world metres).
@@ -224,12 +239,10 @@ class ParallaxMap:
         """
         pos = _point("position", position)
         sd = self.config.sector_deg
-        out = None
-        for origin, m in self.parts:
-            wall = self.wall_points(origin)
-            moved = m.regrouped(sector_of(*(wall - pos).T, sd))
-            out = moved if out is None else out.merge(moved)
-        return out
+        return _added(
+            m.regrouped(sector_of(*(self.wall_points(origin) - pos).T, sd))
+            for origin, m in self.parts
+        )
 
     def centred(self) -> VisualCompass:
         """All parts re-drawn for the spot and added up (cached): every spot sector
@@ -238,11 +251,9 @@ class ParallaxMap:
         if self._centred is None:
             wall = self._spot_wall + self.spot
             sd = self.config.sector_deg
-            out = None
-            for origin, m in self.parts:
-                moved = m.resampled(sector_of(*(wall - origin).T, sd))
-                out = moved if out is None else out.merge(moved)
-            self._centred = out
+            self._centred = _added(
+                m.resampled(sector_of(*(wall - origin).T, sd)) for origin, m in self.parts
+            )
         return self._centred
 
     def sector_maps(self, positions: np.ndarray) -> np.ndarray:
@@ -252,8 +263,8 @@ class ParallaxMap:
         pos = np.asarray(positions, dtype=np.float64)
         if pos.ndim != 2 or pos.shape[1] != 2 or not np.all(np.isfinite(pos)):
             raise ValueError(f"positions must be an (N, 2) array of finite metres, got {pos.shape}")
-        sd = self.config.sector_deg
-        return np.stack([sector_of(*(self.wall_points(p) - self.spot).T, sd) for p in pos])
+        rel = self._walls(pos) - self.spot
+        return sector_of(rel[..., 0], rel[..., 1], self.config.sector_deg)
 
     def pose_log_likelihood(
         self, image: np.ndarray, camera: Camera, positions: np.ndarray

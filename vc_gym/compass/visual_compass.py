@@ -498,15 +498,22 @@ class VisualCompass:
         out._light.columns = self._light.columns[source]
         return out
 
-    def _checked_sectors(self, name: str, sectors: np.ndarray) -> np.ndarray:
+    def _checked_sectors(self, name: str, sectors: np.ndarray, rows: bool = False) -> np.ndarray:
+        """``sectors`` as an integer array of map sectors: ``(n_sectors,)``, or
+        ``(N, n_sectors)`` with ``rows``; a clear ``ValueError`` otherwise."""
         n = self.config.n_sectors
         sectors = np.asarray(sectors)
-        if sectors.shape != (n,) or not np.issubdtype(sectors.dtype, np.integer):
+        shape = f"(N, {n})" if rows else f"({n},)"
+        if (
+            sectors.ndim != (2 if rows else 1)
+            or sectors.shape[-1] != n
+            or not np.issubdtype(sectors.dtype, np.integer)
+        ):
             raise ValueError(
-                f"{name} must be an integer array of shape ({n},), got "
+                f"{name} must be an integer array of shape {shape}, got "
                 f"{sectors.dtype} {sectors.shape}"
             )
-        if sectors.min() < 0 or sectors.max() >= n:
+        if sectors.size and (sectors.min() < 0 or sectors.max() >= n):
             raise ValueError(
                 f"{name} sectors must lie in [0, {n}), got {sectors.min()}..{sectors.max()}"
             )
@@ -720,18 +727,7 @@ class VisualCompass:
         self._checked(image, camera, need_map=True)
         if self.config.exposure == "map":
             raise ValueError('log_likelihood_remapped does not support exposure="map"')
-        n_sec = self.config.n_sectors
-        remap = np.asarray(sector_maps)
-        if (
-            remap.ndim != 2
-            or remap.shape[1] != n_sec
-            or not np.issubdtype(remap.dtype, np.integer)
-            or (remap.size and (remap.min() < 0 or remap.max() >= n_sec))
-        ):
-            raise ValueError(
-                f"sector_maps must be an (N, {n_sec}) integer array of sectors in "
-                f"[0, {n_sec}), got {remap.dtype} {remap.shape}"
-            )
+        remap = self._checked_sectors("sector_maps", sector_maps, rows=True)
         gain = self._checked_gain(gain)
         geom, counts, total = self._sector_features(
             image, camera, self._gain_for(image, camera, gain)
@@ -743,10 +739,7 @@ class VisualCompass:
         idx = remap[:, geom.roll_index]  # (N, K, S): map sector of relative k at start s0
         k = np.arange(geom.n_rel)[None, :, None]
         by_start = per_group[:, k, 0, idx].sum(axis=2)  # (P, N, S)
-        ll = by_start[geom.heading_phase, :, geom.heading_sector].T  # (N, n_headings)
-        if self.config.temperature != 1.0:
-            ll = ll / self.config.temperature
-        return np.ascontiguousarray(ll)
+        return _by_heading(self.config, geom, by_start.transpose(2, 0, 1))
 
     def estimate(
         self, image: np.ndarray, camera: Camera, gain: float | None = None
@@ -1005,7 +998,13 @@ def _log_likelihoods_of(
     # score[p, m, s0] = sum_k per_group[p, k, m, s0 + k + kmin]; the advanced indices
     # come first: (K, S, P, M), summed over K
     by_start = per_group[:, np.arange(geom.n_rel)[:, None], :, geom.roll_index].sum(axis=0)
-    ll = by_start[geom.heading_sector, geom.heading_phase].T  # (M, n_headings)
+    return _by_heading(config, geom, by_start)
+
+
+def _by_heading(config: CompassConfig, geom: _Geometry, by_start: np.ndarray) -> np.ndarray:
+    """``(X, n_headings)`` log-likelihoods from the scores ``by_start[s0, p, x]`` of
+    every starting sector and phase (``X`` maps, or re-indexings of one map)."""
+    ll = by_start[geom.heading_sector, geom.heading_phase].T
     if config.temperature != 1.0:
         ll = ll / config.temperature
     return np.ascontiguousarray(ll)
