@@ -62,6 +62,7 @@ _TRAIN_FIELDS = {
     "save_freq": "save_freq",
     "demo_episodes": "demo_episodes",
     "places": "places",
+    "collector": "collector",
 }
 
 
@@ -218,19 +219,22 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             timesteps=args.timesteps, n_envs=args.n_envs, seed=args.seed, progress=not args.json
         )
         if not args.json:
+            n = result["n_envs"]
             print(
-                f"training {result['train_decisions_per_s']:.1f} decisions/s with "
-                f"{result['n_envs']} workers; one env alone {result['env_decisions_per_s']:.1f} "
-                f"decisions/s; efficiency {result['efficiency']:.2f} of "
-                f"{result['n_envs']} x the env's rate (target {result['target_efficiency']})"
+                f"one env alone: {result['env_decisions_per_s']:.1f} decisions/s, "
+                f"{result['env_task_steps_per_s']:.1f} task-env steps/s "
+                f"({result['env_task_steps_per_decision']:.2f} per decision)"
             )
-            print(
-                f"in task-env steps: training {result['train_task_steps_per_s']:.1f}/s "
-                f"({result['train_task_steps_per_decision']:.2f} per decision), one env alone "
-                f"{result['env_task_steps_per_s']:.1f}/s "
-                f"({result['env_task_steps_per_decision']:.2f} per decision); efficiency "
-                f"{result['task_step_efficiency']:.2f}"
-            )
+            for name, r in result["collectors"].items():
+                print(
+                    f"training, {name:8s} collector: {r['train_decisions_per_s']:.1f} "
+                    f"decisions/s with {n} workers, efficiency {r['efficiency']:.2f} of {n} x "
+                    f"the env's rate (target {result['target_efficiency']}); in task-env "
+                    f"steps {r['train_task_steps_per_s']:.1f}/s, efficiency "
+                    f"{r['task_step_efficiency']:.2f}"
+                )
+            if "async_over_lockstep" in result:
+                print(f"async / lockstep decisions/s: {result['async_over_lockstep']:.2f}")
     else:  # pragma: no cover - argparse restricts the choices
         raise AssertionError(args.what)
     if args.out:
@@ -574,8 +578,9 @@ def build_parser() -> argparse.ArgumentParser:
             "the homing experiment's episodes with 1 local worker, --workers local workers and "
             "a local Ray instance of --workers CPUs (atlas learned once; the results must be "
             "byte-identical). train: agent decisions per second of PPO training with --n-envs "
-            "workers next to one vc_gym/Homing-v0 stepping alone (before and after, same run), "
-            "and their ratio (efficiency; target 0.7). The last line of --json output is one "
+            "workers, once with SB3's lockstep collector and once with the asynchronous one, "
+            "next to one vc_gym/Homing-v0 stepping alone (before and after, same run), and "
+            "their ratios (efficiency; target 0.7). The last line of --json output is one "
             "JSON object."
         ),
     )
@@ -705,6 +710,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--tracker",
         metavar="NAME",
         help="tracker of the agent's env: grid (the paper's filters, default), particle or kalman",
+    )
+    p.add_argument(
+        "--collector",
+        choices=["lockstep", "async"],
+        help="how PPO collects rollouts from the workers: lockstep (SB3's, default; every "
+        "step waits for the slowest worker) or async (each worker steps as soon as it has "
+        "its action; the same rollouts, faster when a checked stop stands)",
     )
     p.add_argument(
         "--eval-freq",

@@ -120,15 +120,25 @@ def test_the_speed_benchmark_reports_training_next_to_the_env():
 
     r = bench_train(timesteps=32, n_envs=1, env_steps=10, learn_time_s=0.2, progress=False)
     assert r["n_envs"] == 1 and len(r["env_rounds_decisions_per_s"]) == 2
-    assert r["env_decisions_per_s"] > 0 and r["train_decisions_per_s"] > 0
-    assert r["efficiency"] == pytest.approx(
-        r["train_decisions_per_s"] / r["env_decisions_per_s"], rel=0.01
+    assert r["env_decisions_per_s"] > 0 and r["env_task_steps_per_decision"] >= 1.0
+    assert set(r["collectors"]) == {"lockstep", "async"}
+    for c in r["collectors"].values():
+        assert c["train_decisions_per_s"] > 0
+        assert c["efficiency"] == pytest.approx(
+            c["train_decisions_per_s"] / r["env_decisions_per_s"], rel=0.01
+        )
+        # a decision is at least one task-env step (a stop that stands is many)
+        assert c["train_task_steps_per_decision"] >= 1.0
+        assert c["task_step_efficiency"] == pytest.approx(
+            c["train_task_steps_per_s"] / r["env_task_steps_per_s"], rel=0.01
+        )
+    assert r["async_over_lockstep"] == pytest.approx(
+        r["collectors"]["async"]["train_decisions_per_s"]
+        / r["collectors"]["lockstep"]["train_decisions_per_s"],
+        rel=0.01,
     )
-    # a decision is at least one task-env step (a stop that stands is many)
-    assert r["train_task_steps_per_decision"] >= 1.0 and r["env_task_steps_per_decision"] >= 1.0
-    assert r["task_step_efficiency"] == pytest.approx(
-        r["train_task_steps_per_s"] / r["env_task_steps_per_s"], rel=0.01
-    )
+    with pytest.raises(ValueError, match="collectors"):
+        bench_train(timesteps=32, collectors=("fast",), progress=False)
 
 
 def test_reloaded_model_gives_the_same_actions(trained):

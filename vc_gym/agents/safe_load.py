@@ -138,7 +138,9 @@ def _checked_data(path: Path) -> dict[str, Any]:
     return data
 
 
-def load_sb3_model(algo: str, path: str | os.PathLike, env: Any = None, device: str = "cpu"):
+def load_sb3_model(
+    algo: str, path: str | os.PathLike, env: Any = None, device: str = "cpu", cls: Any = None
+):
     """``PPO.load`` / ``SAC.load`` of a vc_gym homing agent, never unpickling anything.
 
     Parameters
@@ -151,6 +153,8 @@ def load_sb3_model(algo: str, path: str | os.PathLike, env: Any = None, device: 
         Passed to ``load`` (to continue training).
     device : str
         Torch device.
+    cls : type, optional
+        A subclass of the algorithm's class to load into (a training run's own PPO).
 
     Raises
     ------
@@ -164,7 +168,11 @@ def load_sb3_model(algo: str, path: str | os.PathLike, env: Any = None, device: 
         raise ValueError(f"algo must be 'ppo' or 'sac', got {algo!r}")
     from stable_baselines3 import PPO, SAC
 
-    cls = {"ppo": PPO, "sac": SAC}[algo]
+    base = {"ppo": PPO, "sac": SAC}[algo]
+    if cls is None:
+        cls = base
+    elif not (isinstance(cls, type) and issubclass(cls, base)):
+        raise ValueError(f"cls must be a subclass of {base.__name__}, got {cls!r}")
     p = Path(path)
     try:
         data = _checked_data(p)

@@ -7,7 +7,10 @@ actions in this process, resets included, after its learning phase. ``train`` ru
 learned once and shared) and reports its decisions per second while the policy trains.
 The env is measured before and after training (median of the rounds), in the same run.
 ``efficiency`` = training decisions/s ÷ (``n_envs`` × env decisions/s): 1 would mean the
-workers never wait for each other or for the policy.
+workers never wait for each other or for the policy. Training runs once with each
+collector (``TrainConfig.collector``): SB3's lockstep, where every step waits for the
+slowest worker, and the asynchronous one (:mod:`vc_gym.experiments.async_rollouts`), where
+each worker steps as soon as it has its action.
 
 A decision is not a fixed amount of work: a stop that stands holds its decision for up
 to the whole stand (50 steps of the task env), and the policy stops more or less often
@@ -21,13 +24,20 @@ from __future__ import annotations
 
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.experiments.training import TrainConfig, learn_places, train, training_env
+from vc_gym.experiments.training import (
+    COLLECTORS,
+    TrainConfig,
+    learn_places,
+    train,
+    training_env,
+)
 from vc_gym.validation import int_at_least
 
 __all__ = ["bench_train"]
@@ -60,54 +70,77 @@ def bench_train(
     learn_time_s: float = 0.5,
     seed: int = 0,
     progress: bool = True,
+    collectors: tuple[str, ...] = COLLECTORS,
 ) -> dict[str, Any]:
     """Measure training decisions/s next to ``n_envs`` × one env's decisions/s.
 
     Parameters
     ----------
     timesteps : int
-        Decisions to train for (PPO, the default hyperparameters otherwise).
+        Decisions to train for with each collector (PPO, the default hyperparameters
+        otherwise).
     n_envs : int
-        Worker processes of the training run.
+        Worker processes of the training runs.
     env_steps : int
         Decisions of each single-env round (one round before training, one after).
     learn_time_s : float
         Learning time per direction of the (untimed) learning phase.
     seed : int
-        Seed of the learning phase, the env rounds and the training run.
+        Seed of the learning phase, the env rounds and the training runs.
+    collectors : tuple of str
+        ``TrainConfig.collector`` values to train with, one after the other in this run
+        (default: SB3's lockstep and the asynchronous one).
 
     Returns
     -------
     dict
-        ``env_decisions_per_s``, ``train_decisions_per_s``, ``n_envs``, ``efficiency``,
-        the same in task-env steps (``env_task_steps_per_s``,
-        ``train_task_steps_per_s``, ``task_step_efficiency``) and the settings.
+        ``env_decisions_per_s`` and ``env_task_steps_per_s`` (one env alone), and per
+        collector (``collectors``) ``train_decisions_per_s``, ``efficiency``, the same
+        in task-env steps (``train_task_steps_per_s``, ``task_step_efficiency``,
+        ``train_task_steps_per_decision``); with both collectors
+        ``async_over_lockstep``, the ratio of their decision rates; and the settings.
     """
     int_at_least("env_steps", env_steps, 1)
+    collectors = tuple(collectors)
+    if not collectors or any(c not in COLLECTORS for c in collectors):
+        raise ValueError(f"collectors must be a non-empty subset of {COLLECTORS}, got {collectors}")
     config = TrainConfig(  # no warm start: only the training's own speed is measured
         timesteps=timesteps, n_envs=n_envs, seed=seed, learn_time_s=learn_time_s, demo_episodes=0
     )
+    runs = {}
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
         # the place is learned once into the run folder, where train() finds it
         learn_places(config, tmp)
         before = _env_rate(config, Path(tmp), env_steps, seed)
-        run = train(config, tmp, progress=progress)
+        for name in collectors:
+            runs[name] = train(replace(config, collector=name), tmp, progress=progress)
         after = _env_rate(config, Path(tmp), env_steps, seed + 1)
     env_rate = float(np.median([before[0], after[0]]))
     env_task_rate = float(np.median([before[1], after[1]]))
-    train_rate = float(run["decisions_per_s"])
-    train_task_rate = float(run["task_steps_per_s"])
-    return {
+    per_collector = {}
+    for name, run in runs.items():
+        rate, task_rate = float(run["decisions_per_s"]), float(run["task_steps_per_s"])
+        per_collector[name] = {
+            "train_decisions_per_s": round(rate, 2),
+            "efficiency": round(rate / (n_envs * env_rate), 3),
+            "train_task_steps_per_s": round(task_rate, 2),
+            "task_step_efficiency": round(task_rate / (n_envs * env_task_rate), 3),
+            "train_task_steps_per_decision": round(task_rate / rate, 3),
+        }
+    result: dict[str, Any] = {
         "timesteps": timesteps,
         "n_envs": n_envs,
         "env_decisions_per_s": round(env_rate, 2),
         "env_rounds_decisions_per_s": [round(before[0], 2), round(after[0], 2)],
-        "train_decisions_per_s": round(train_rate, 2),
-        "efficiency": round(train_rate / (n_envs * env_rate), 3),
-        "target_efficiency": 0.7,
         "env_task_steps_per_s": round(env_task_rate, 2),
-        "train_task_steps_per_s": round(train_task_rate, 2),
-        "task_step_efficiency": round(train_task_rate / (n_envs * env_task_rate), 3),
         "env_task_steps_per_decision": round(env_task_rate / env_rate, 3),
-        "train_task_steps_per_decision": round(train_task_rate / train_rate, 3),
+        "target_efficiency": 0.7,
+        "collectors": per_collector,
     }
+    if {"lockstep", "async"} <= set(per_collector):
+        result["async_over_lockstep"] = round(
+            per_collector["async"]["train_decisions_per_s"]
+            / per_collector["lockstep"]["train_decisions_per_s"],
+            3,
+        )
+    return result

@@ -38,6 +38,8 @@ __all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
 CONFIG_SCHEMA = 2
 #: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
 DEFAULT_DEMO_EPISODES = {"ppo": 60, "sac": 0}
+#: Accepted values of ``TrainConfig.collector``.
+COLLECTORS = ("lockstep", "async")
 #: At most this many places per training run (each is a PyBullet world in every worker).
 MAX_PLACES = 16
 
@@ -86,6 +88,12 @@ class TrainConfig:
         stops of 0.1 s). ``None``: a stop is final.
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
+    collector : str
+        How PPO collects its rollouts from the ``"subproc"`` workers: ``"lockstep"``
+        (SB3's: every step waits for the slowest worker) or ``"async"`` (each worker
+        steps as soon as it has its next action, :mod:`vc_gym.experiments.async_rollouts`;
+        the same rollouts, faster when decisions differ in cost, as a checked stop's
+        stand does).
     net_arch : tuple of int
         Hidden layers of the policy and value MLPs.
     learning_rate, gamma : float
@@ -135,6 +143,7 @@ class TrainConfig:
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
+    collector: str = "lockstep"
     net_arch: tuple[int, ...] = (64, 64)
     learning_rate: float = 3e-4
     gamma: float = 0.99
@@ -159,6 +168,13 @@ class TrainConfig:
             raise ValueError(f"tracker must be a tracker name, got {self.tracker!r}")
         if self.vec_env not in ("subproc", "dummy"):
             raise ValueError(f"vec_env must be 'subproc' or 'dummy', got {self.vec_env!r}")
+        if self.collector not in COLLECTORS:
+            raise ValueError(f"collector must be one of {COLLECTORS}, got {self.collector!r}")
+        if self.collector == "async" and (self.algo != "ppo" or self.vec_env != "subproc"):
+            raise ValueError(
+                "collector 'async' needs algo 'ppo' and vec_env 'subproc' (worker processes; "
+                "vc-gym train --n-envs 1 runs its env in-process)"
+            )
         for name in ("timesteps", "n_envs", "n_steps", "batch_size", "eval_episodes"):
             int_at_least(name, getattr(self, name), 1)
         for name in ("eval_freq", "eval_seed", "save_freq", "seed", "demo_episodes"):
@@ -432,7 +448,13 @@ def train(
         _EnvFactory(config, i, out, out / "monitor" / str(i), append=resume)
         for i in range(config.n_envs)
     ]
-    if config.vec_env == "subproc":
+    algo_cls = algo
+    if config.collector == "async":
+        from vc_gym.experiments.async_rollouts import AsyncRolloutPPO, AsyncSubprocVecEnv
+
+        algo_cls = AsyncRolloutPPO
+        venv = AsyncSubprocVecEnv(factories, start_method="forkserver")
+    elif config.vec_env == "subproc":
         venv = SubprocVecEnv(factories, start_method="forkserver")
     else:
         venv = DummyVecEnv(factories)
@@ -474,11 +496,11 @@ def train(
     tb = None if tensorboard_log is None else str(tensorboard_log)  # a str: plain JSON in the zip
     try:
         if checkpoint is not None:
-            model = load_sb3_model(config.algo, checkpoint, env=venv, device="cpu")
+            model = load_sb3_model(config.algo, checkpoint, env=venv, device="cpu", cls=algo_cls)
             if tb is not None:
                 model.tensorboard_log = tb
         else:
-            model = algo("MlpPolicy", venv, tensorboard_log=tb, **_algo_kwargs(config))
+            model = algo_cls("MlpPolicy", venv, tensorboard_log=tb, **_algo_kwargs(config))
             if config.demo_episodes:
                 warm_start = _warm_start(model, venv, config, progress)
                 write_json(out / "warm_start.json", warm_start)

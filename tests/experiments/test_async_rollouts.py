@@ -1,0 +1,135 @@
+"""Asynchronous PPO rollouts: PPO's buffer, independent of timing, dead workers, training."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+import torch  # noqa: E402
+from toy_envs import counting_env  # noqa: E402
+
+from vc_gym.agents.learned import LearnedHomingAgent  # noqa: E402
+from vc_gym.experiments.async_rollouts import (  # noqa: E402
+    AsyncRolloutPPO,
+    AsyncSubprocVecEnv,
+    WorkerDiedError,
+)
+from vc_gym.experiments.training import TrainConfig, train  # noqa: E402
+
+N_STEPS = 12
+
+
+def _model(delays, die_at=None, seed=3):
+    venv = AsyncSubprocVecEnv(
+        [counting_env(i, d, die_at if i == 1 else None) for i, d in enumerate(delays)],
+        start_method="forkserver",
+    )
+    model = AsyncRolloutPPO(
+        "MlpPolicy", venv, n_steps=N_STEPS, batch_size=12, n_epochs=2, seed=seed, device="cpu"
+    )
+    return model, venv
+
+
+def _parameters(model) -> list[torch.Tensor]:
+    return [p.detach().clone() for p in model.policy.parameters()]
+
+
+def test_each_env_fills_its_own_consecutive_rows():
+    model, venv = _model([0.0, 0.01])  # env 1 is slower: env 0 runs ahead
+    try:
+        model.learn(total_timesteps=2 * N_STEPS)  # one rollout
+        rb = model.rollout_buffer
+        # PPO's update has flattened the (step, env) observations env by env; the
+        # episode starts keep their (step, env) layout
+        assert rb.observations.shape == (2 * N_STEPS, 3)
+        obs = rb.observations.reshape(2, N_STEPS, 3)
+        starts = rb.episode_starts.T
+        for i in range(2):
+            assert np.all(obs[i, :, 1] == i)  # env i's rows hold env i only
+            step = np.rint(obs[i, :, 0] * 10).astype(int)
+            # each env's own steps in order: 0, 1, 2, 3, 4, 0, 1, ... across resets
+            assert list(step) == [t % 5 for t in range(N_STEPS)]
+            assert list(starts[i]) == [float(s == 0) for s in step]
+            episode = np.rint(obs[i, :, 2] * 10).astype(int)
+            assert list(episode) == [t // 5 for t in range(N_STEPS)]
+        assert model.num_timesteps == 2 * N_STEPS
+        assert np.all(np.isfinite(rb.returns)) and np.all(np.isfinite(rb.advantages))
+    finally:
+        venv.close()
+
+
+def test_the_policy_does_not_depend_on_which_worker_is_slower():
+    results = []
+    for delays in ([0.0, 0.006], [0.006, 0.0]):
+        model, venv = _model(delays)
+        try:
+            model.learn(total_timesteps=4 * N_STEPS)  # two rollouts, one update between
+            results.append(_parameters(model))
+        finally:
+            venv.close()
+    assert all(torch.equal(a, b) for a, b in zip(*results, strict=True))
+    # and the seed matters (the test could fail)
+    model, venv = _model([0.0, 0.0], seed=4)
+    try:
+        model.learn(total_timesteps=4 * N_STEPS)
+        assert not all(
+            torch.equal(a, b) for a, b in zip(results[0], _parameters(model), strict=True)
+        )
+    finally:
+        venv.close()
+
+
+def test_a_dead_worker_is_a_clear_error():
+    model, venv = _model([0.0, 0.0], die_at=5)
+    try:
+        with pytest.raises(WorkerDiedError, match="worker 1"):
+            model.learn(total_timesteps=4 * N_STEPS)
+    finally:
+        venv.close()
+
+
+def test_the_collector_is_checked():
+    with pytest.raises(ValueError, match="collector must be one of"):
+        TrainConfig(collector="fast")
+    with pytest.raises(ValueError, match="needs algo 'ppo' and vec_env 'subproc'"):
+        TrainConfig(collector="async", algo="sac")
+    with pytest.raises(ValueError, match="needs algo 'ppo' and vec_env 'subproc'"):
+        TrainConfig(collector="async", vec_env="dummy")
+
+
+def test_a_model_loads_only_into_a_subclass_of_its_algorithm(tmp_path):
+    from stable_baselines3 import SAC
+
+    from vc_gym.agents.safe_load import load_sb3_model
+
+    with pytest.raises(ValueError, match="cls must be a subclass of PPO"):
+        load_sb3_model("ppo", tmp_path / "model.zip", cls=SAC)
+
+
+def test_vc_gym_train_with_the_async_collector(tmp_path):
+    config = TrainConfig(
+        timesteps=64,
+        n_envs=2,
+        learn_time_s=0.2,
+        n_steps=32,
+        batch_size=32,
+        max_homing_s=3.0,
+        stop_time_s=0.3,
+        eval_freq=0,
+        demo_episodes=0,
+        collector="async",
+    )
+    summary = train(config, tmp_path, progress=False)
+    assert summary["decisions_per_s"] > 0 and summary["episodes"] > 0
+    # an ordinary PPO model.zip: the safe loader reads it (nothing of the collector pickled)
+    agent = LearnedHomingAgent(tmp_path / "model.zip")
+    # and a training run's own class loads it too (what --resume does)
+    from vc_gym.agents.safe_load import load_sb3_model
+
+    assert isinstance(
+        load_sb3_model("ppo", tmp_path / "model.zip", cls=AsyncRolloutPPO), AsyncRolloutPPO
+    )
+    obs = np.zeros(agent.make_env().observation_space.shape, np.float32)
+    assert agent.predict(obs).shape == (3,)
