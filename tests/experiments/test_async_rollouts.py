@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 pytest.importorskip("stable_baselines3")
 
 import torch  # noqa: E402
+from test_training import TINY  # noqa: E402
 from toy_envs import counting_env  # noqa: E402
 
 from vc_gym.agents.learned import LearnedHomingAgent  # noqa: E402
@@ -109,18 +112,7 @@ def test_a_model_loads_only_into_a_subclass_of_its_algorithm(tmp_path):
 
 
 def test_vc_gym_train_with_the_async_collector(tmp_path):
-    config = TrainConfig(
-        timesteps=64,
-        n_envs=2,
-        learn_time_s=0.2,
-        n_steps=32,
-        batch_size=32,
-        max_homing_s=3.0,
-        stop_time_s=0.3,
-        eval_freq=0,
-        demo_episodes=0,
-        collector="async",
-    )
+    config = replace(TINY, eval_freq=0, save_freq=0, collector="async")
     summary = train(config, tmp_path, progress=False)
     assert summary["decisions_per_s"] > 0 and summary["episodes"] > 0
     # an ordinary PPO model.zip: the safe loader reads it (nothing of the collector pickled)
