@@ -95,6 +95,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
     }
     if "n_envs" in given:
         given["vec_env"] = "dummy" if given["n_envs"] == 1 else "subproc"
+        if given["n_envs"] == 1:  # one env runs in-process: nothing to collect from
+            given.setdefault("collector", "lockstep")
     if args.seeds is not None and (args.resume or "seed" in given or args.tensorboard_log):
         raise ValueError("--seeds runs a sweep: no --seed, --resume or --tensorboard-log with it")
     if args.resume:
@@ -714,9 +716,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--collector",
         choices=["lockstep", "async"],
-        help="how PPO collects rollouts from the workers: lockstep (SB3's, default; every "
-        "step waits for the slowest worker) or async (each worker steps as soon as it has "
-        "its action; the same rollouts, faster when a checked stop stands)",
+        help="how PPO collects rollouts from the workers: async (default with PPO and 2+ "
+        "workers; each worker steps as soon as it has its action: the same rollouts, faster "
+        "when a checked stop stands) or lockstep (SB3's: every step waits for the slowest "
+        "worker; the default otherwise, and what runs saved without this setting used)",
     )
     p.add_argument(
         "--eval-freq",

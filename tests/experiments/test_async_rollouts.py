@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -24,12 +25,12 @@ from vc_gym.experiments.training import TrainConfig, train  # noqa: E402
 N_STEPS = 12
 
 
-def _model(delays, die_at=None, seed=3):
+def _model(delays, die_at=None, seed=3, cls=AsyncRolloutPPO):
     venv = AsyncSubprocVecEnv(
         [counting_env(i, d, die_at if i == 1 else None) for i, d in enumerate(delays)],
         start_method="forkserver",
     )
-    model = AsyncRolloutPPO(
+    model = cls(
         "MlpPolicy", venv, n_steps=N_STEPS, batch_size=12, n_epochs=2, seed=seed, device="cpu"
     )
     return model, venv
@@ -93,6 +94,34 @@ def test_a_dead_worker_is_a_clear_error():
         venv.close()
 
 
+def test_a_dead_worker_is_a_clear_error_in_lockstep_too():
+    from stable_baselines3 import PPO
+
+    model, venv = _model([0.0, 0.0], die_at=5, cls=PPO)  # SB3's own collect_rollouts
+    try:
+        with pytest.raises(WorkerDiedError, match="ended while stepping"):
+            model.learn(total_timesteps=4 * N_STEPS)
+    finally:
+        venv.close()  # skips the dead worker: no BrokenPipeError hides the error
+
+
+def test_ppo_in_worker_processes_collects_asynchronously_by_default():
+    assert TrainConfig().collector == "async"
+    assert TrainConfig(vec_env="dummy").collector == "lockstep"  # vc-gym train --n-envs 1
+    assert TrainConfig(algo="sac").collector == "lockstep"
+    # a config.json saved before the choice existed was trained in lockstep
+    saved = {k: v for k, v in TrainConfig().to_dict().items() if k != "collector"}
+    assert TrainConfig.from_dict(saved).collector == "lockstep"
+    # the shipped policy's config is one of those
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+    from vc_gym.experiments.training import read_train_config
+
+    shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
+    assert shipped.collector == json.loads(
+        (PRETRAINED_MODEL.parent / "config.json").read_text()
+    ).get("collector", "lockstep")
+
+
 def test_the_collector_is_checked():
     with pytest.raises(ValueError, match="collector must be one of"):
         TrainConfig(collector="fast")
@@ -111,8 +140,9 @@ def test_a_model_loads_only_into_a_subclass_of_its_algorithm(tmp_path):
         load_sb3_model("ppo", tmp_path / "model.zip", cls=SAC)
 
 
-def test_vc_gym_train_with_the_async_collector(tmp_path):
-    config = replace(TINY, eval_freq=0, save_freq=0, collector="async")
+def test_vc_gym_train_with_the_lockstep_collector(tmp_path):
+    # TINY trains asynchronously (the default, test_training); this is SB3's collector
+    config = replace(TINY, eval_freq=0, save_freq=0, collector="lockstep")
     summary = train(config, tmp_path, progress=False)
     assert summary["decisions_per_s"] > 0 and summary["episodes"] > 0
     # an ordinary PPO model.zip: the safe loader reads it (nothing of the collector pickled)

@@ -105,6 +105,9 @@ def test_config_file_and_command_line(tmp_path):
     config = read_train_config(cfg, timesteps=500)
     assert config.net_arch == (32, 32) and config.learning_rate == 0.001
     assert config.scene == "office" and config.timesteps == 500 and config.gamma == 0.99
+    # fields a settings file leaves out take today's defaults (a saved config.json's
+    # take the values of its era, test_stops_are_checked_in_training...)
+    assert config.confirm_stop_m == 0.25 and config.collector == "async"
     # a run's own config.json reads back as the same config
     saved = tmp_path / "config.json"
     saved.write_text(json.dumps(TINY.to_dict()))
@@ -217,7 +220,7 @@ def test_bad_train_config(kwargs):
 
 
 def test_warm_start_clones_the_expert_and_is_evaluated_before_ppo(tmp_path):
-    config = replace(TINY, demo_episodes=2, save_freq=0, vec_env="dummy")
+    config = replace(TINY, demo_episodes=2, save_freq=0, vec_env="dummy", collector="lockstep")
     summary = train(config, tmp_path, progress=False)
     warm = json.loads((tmp_path / "warm_start.json").read_text())
     assert warm == summary["warm_start"]
@@ -330,6 +333,7 @@ def test_training_over_a_pool_of_places(tmp_path):
         places=(0, 1),
         n_envs=1,
         vec_env="dummy",
+        collector="lockstep",
         timesteps=32,
         eval_freq=0,
         save_freq=0,

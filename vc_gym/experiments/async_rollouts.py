@@ -45,8 +45,30 @@ class AsyncSubprocVecEnv(SubprocVecEnv):
     :meth:`send_step` starts one worker's step; :meth:`ready_steps` returns the steps
     that have finished, waiting for at least one. The lockstep ``step`` still works
     between rollouts (the warm start's demonstrations use it) as long as no single
-    step is pending.
+    step is pending. Training uses it for the lockstep collector too: a worker that
+    died is then a :class:`WorkerDiedError`, in lockstep as when stepped alone, and
+    :meth:`close` does not hide it behind a ``BrokenPipeError``.
     """
+
+    _DIED = (BrokenPipeError, ConnectionResetError, EOFError)
+
+    def step_async(self, actions: np.ndarray) -> None:
+        """SB3's lockstep step; a worker that has ended is a :class:`WorkerDiedError`."""
+        try:
+            super().step_async(actions)
+        except self._DIED:
+            raise WorkerDiedError("a training worker has ended (see its error above)") from None
+
+    def step_wait(self):
+        """SB3's lockstep step; a worker that ended while stepping is a
+        :class:`WorkerDiedError`."""
+        try:
+            return super().step_wait()
+        except self._DIED:
+            self.waiting = False
+            raise WorkerDiedError(
+                "a training worker ended while stepping (see its error above)"
+            ) from None
 
     def send_step(self, index: int, action: np.ndarray) -> None:
         """Start worker ``index``'s step with ``action``.
@@ -58,7 +80,7 @@ class AsyncSubprocVecEnv(SubprocVecEnv):
         """
         try:
             self.remotes[index].send(("step", action))
-        except (BrokenPipeError, ConnectionResetError, EOFError):
+        except self._DIED:
             raise WorkerDiedError(f"training worker {index} has ended") from None
 
     def close(self) -> None:
@@ -69,7 +91,7 @@ class AsyncSubprocVecEnv(SubprocVecEnv):
         for remote in self.remotes:
             try:
                 remote.send(("close", None))
-            except (BrokenPipeError, ConnectionResetError, EOFError):
+            except self._DIED:
                 pass
         for process in self.processes:
             process.join()
@@ -95,7 +117,7 @@ class AsyncSubprocVecEnv(SubprocVecEnv):
             i = by_remote[id(remote)]
             try:
                 obs, reward, done, info, reset_info = remote.recv()
-            except (EOFError, ConnectionResetError):
+            except self._DIED:
                 raise WorkerDiedError(
                     f"training worker {i} ended while stepping (see its error above)"
                 ) from None

@@ -43,10 +43,6 @@ COLLECTORS = ("lockstep", "async")
 #: At most this many places per training run (each is a PyBullet world in every worker).
 MAX_PLACES = 16
 
-#: The PPO policy shipped with the package (trained by ``vc-gym train``, see README);
-#: ``vc-gym evaluate --agent pretrained`` evaluates it.
-PRETRAINED_MODEL = Path(__file__).parent / "pretrained" / "ppo_robolab" / "model.zip"
-
 
 @dataclass(frozen=True)
 class TrainConfig:
@@ -88,12 +84,14 @@ class TrainConfig:
         stops of 0.1 s). ``None``: a stop is final.
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
-    collector : str
-        How PPO collects its rollouts from the ``"subproc"`` workers: ``"lockstep"``
-        (SB3's: every step waits for the slowest worker) or ``"async"`` (each worker
-        steps as soon as it has its next action, :mod:`vc_gym.experiments.async_rollouts`;
-        the same rollouts, faster when decisions differ in cost, as a checked stop's
-        stand does).
+    collector : str, optional
+        How PPO collects its rollouts from the ``"subproc"`` workers: ``"async"`` (each
+        worker steps as soon as it has its next action,
+        :mod:`vc_gym.experiments.async_rollouts`; the same rollouts as SB3's, faster
+        when decisions differ in cost, as a checked stop's stand does) or
+        ``"lockstep"`` (SB3's: every step waits for the slowest worker). Default
+        (``None``): ``"async"`` with PPO in worker processes, else ``"lockstep"``. A
+        ``config.json`` saved before the field existed was trained in lockstep.
     net_arch : tuple of int
         Hidden layers of the policy and value MLPs.
     learning_rate, gamma : float
@@ -143,7 +141,7 @@ class TrainConfig:
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
-    collector: str = "lockstep"
+    collector: str | None = None
     net_arch: tuple[int, ...] = (64, 64)
     learning_rate: float = 3e-4
     gamma: float = 0.99
@@ -168,6 +166,9 @@ class TrainConfig:
             raise ValueError(f"tracker must be a tracker name, got {self.tracker!r}")
         if self.vec_env not in ("subproc", "dummy"):
             raise ValueError(f"vec_env must be 'subproc' or 'dummy', got {self.vec_env!r}")
+        if self.collector is None:
+            parallel = self.algo == "ppo" and self.vec_env == "subproc"
+            object.__setattr__(self, "collector", "async" if parallel else "lockstep")
         if self.collector not in COLLECTORS:
             raise ValueError(f"collector must be one of {COLLECTORS}, got {self.collector!r}")
         if self.collector == "async" and (self.algo != "ppo" or self.vec_env != "subproc"):
@@ -251,25 +252,35 @@ class TrainConfig:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TrainConfig:
-        """Inverse of :meth:`to_dict`; unknown keys or another schema are errors."""
+        """Inverse of :meth:`to_dict`; unknown keys or another schema are errors.
+
+        A field missing from a saved config takes the value it had before the field
+        existed (final stops, lockstep rollouts), not today's default.
+        """
         data = dict(data)
         schema = data.pop("schema", None)
         if schema not in (1, CONFIG_SCHEMA):  # schema 1 had no "env" (derived from the rest)
             raise ValueError(f"config schema {schema!r} is not {CONFIG_SCHEMA}")
         env = data.pop("env", None)
-        known = {f.name for f in fields(cls)}
-        unknown = set(data) - known
+        data.setdefault("confirm_stop_m", None)
+        data.setdefault("collector", "lockstep")
+        config = cls.from_settings(data)
+        if env is not None and env != config.env_kwargs():
+            raise ValueError("the config's 'env' does not match its own fields")
+        return config
+
+    @classmethod
+    def from_settings(cls, data: dict[str, Any]) -> TrainConfig:
+        """A config from any subset of its fields (a hand-written settings file); the
+        rest take their defaults. Unknown keys are errors."""
+        data = dict(data)
+        unknown = set(data) - {f.name for f in fields(cls)}
         if unknown:
             raise ValueError(f"unknown config keys {sorted(unknown)}")
         for name in ("net_arch", "places"):
             if isinstance(data.get(name), list):
                 data[name] = tuple(data[name])
-        # a config saved before stops were checked in training had final stops
-        data.setdefault("confirm_stop_m", None)
-        config = cls(**data)
-        if env is not None and env != config.env_kwargs():
-            raise ValueError("the config's 'env' does not match its own fields")
-        return config
+        return cls(**data)
 
 
 def _place_env(config: TrainConfig, seed: int, atlas_file: Path) -> gym.Env:
@@ -316,19 +327,22 @@ def learn_places(config: TrainConfig, out_dir: str | os.PathLike) -> int:
 
 
 def read_train_config(path: str | os.PathLike, **overrides: Any) -> TrainConfig:
-    """A :class:`TrainConfig` from a YAML or JSON file of its fields (any subset; a
-    ``config.json`` written by :func:`train` works too), with ``overrides`` on top.
+    """A :class:`TrainConfig` from a YAML or JSON file of its fields, with ``overrides``
+    on top. Any subset of the fields: the others take their defaults. A ``config.json``
+    written by :func:`train` works too (it has a ``schema``; a field it lacks takes the
+    value it had when the file was written, :meth:`TrainConfig.from_dict`).
 
     Raises
     ------
     ValueError
         Naming the file, for a file that cannot be read or an unknown or bad field.
     """
-    data = read_settings(path)
-    data.pop("env", None)  # a config.json's derived env arguments
-    data.setdefault("schema", CONFIG_SCHEMA)
+    data = {**read_settings(path), **overrides}
     try:
-        return TrainConfig.from_dict({**data, **overrides})
+        if "schema" in data:  # a run's config.json: its missing fields are its era's
+            data.pop("env", None)  # derived from the fields (a --config file overrides them)
+            return TrainConfig.from_dict(data)
+        return TrainConfig.from_settings(data)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{path}: {exc}") from None
 
@@ -417,8 +431,9 @@ def train(
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
     from stable_baselines3.common.logger import Logger
     from stable_baselines3.common.monitor import Monitor
-    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+    from stable_baselines3.common.vec_env import DummyVecEnv
 
+    from vc_gym.experiments.async_rollouts import AsyncRolloutPPO, AsyncSubprocVecEnv
     from vc_gym.experiments.training_callbacks import EpisodeLog, HeldOutEvaluation
 
     out = Path(out_dir)
@@ -448,14 +463,11 @@ def train(
         _EnvFactory(config, i, out, out / "monitor" / str(i), append=resume)
         for i in range(config.n_envs)
     ]
-    algo_cls = algo
-    if config.collector == "async":
-        from vc_gym.experiments.async_rollouts import AsyncRolloutPPO, AsyncSubprocVecEnv
-
-        algo_cls = AsyncRolloutPPO
+    algo_cls = AsyncRolloutPPO if config.collector == "async" else algo
+    if config.vec_env == "subproc":
+        # SB3's SubprocVecEnv that can also step single workers and closes past a dead
+        # one (its error is then the one raised, not a BrokenPipeError from close)
         venv = AsyncSubprocVecEnv(factories, start_method="forkserver")
-    elif config.vec_env == "subproc":
-        venv = SubprocVecEnv(factories, start_method="forkserver")
     else:
         venv = DummyVecEnv(factories)
     log = EpisodeLog(
