@@ -123,3 +123,26 @@ def test_a_confirmed_stop_is_called_off_when_the_estimate_leaves_home():
 def test_confirm_stop_must_be_a_positive_distance(bad):
     with pytest.raises(ValueError, match="confirm_stop_m"):
         gym.make("vc_gym/Homing-v0", learn_time_s=0.2, confirm_stop_m=bad)
+
+
+@pytest.mark.parametrize("head_scan", [True, False])
+def test_the_head_scans_when_the_robot_does_not_walk_forward(head_scan):
+    env = gym.make("vc_gym/Homing-v0", head_scan=head_scan, **FAST)
+    env.reset(seed=0, options={"pose": (1.0, 0.0, 0.0)})
+    pans = []
+    for _ in range(8):  # turning in place: the scripted agent scans with its head here
+        obs, *_ = env.step(np.array([-1.0, 1.0, -1.0], np.float32))
+        pans.append(float(obs[-1]) * 90.0)
+    if head_scan:
+        assert min(pans) < -15.0 and max(pans) > 15.0
+    else:
+        assert np.allclose(pans, 0.0, atol=2.0)
+    for _ in range(5):  # walking: the head looks ahead
+        obs, *_ = env.step(np.array([1.0, 0.3, -1.0], np.float32))
+    assert abs(float(obs[-1]) * 90.0) < 2.0
+    env.close()
+
+
+def test_head_scan_must_be_a_bool():
+    with pytest.raises(ValueError, match="head_scan"):
+        gym.make("vc_gym/Homing-v0", head_scan="yes", **FAST)

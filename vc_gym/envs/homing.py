@@ -87,6 +87,14 @@ class StopAction(gym.Wrapper):
     ``stop_time_s`` and end the episode by accident (11 % of early PPO episodes ended so
     within three decisions).
 
+    A decision that does not walk forward (turning in place, or standing while a stop is
+    held) scans with the head, the next pan of ``HEAD_SCAN_DEG`` at each step, as the
+    scripted agent does whenever it does not walk: the compass then sees more of the room
+    than straight ahead. Without it (``head_scan=False``, what policies trained before
+    this option saw) a learned agent kidnapped far from home could turn in place for the
+    whole minute: there the tracker's position estimate turns with the robot and keeps
+    home behind it (README, *Learned agents*).
+
     With ``confirm_stop_m`` a stop is checked while the robot stands, as the scripted
     agent checks its own: if at any step of the hold the estimated home (the features'
     home vector) is farther than that, the stop is called off and the step returns, not
@@ -106,6 +114,7 @@ class StopAction(gym.Wrapper):
         max_turn_deg_s: float = 60.0,
         min_walk_s: float = 2.0,
         confirm_stop_m: float | None = None,
+        head_scan: bool = True,
     ):
         super().__init__(env)
         inner = env.action_space
@@ -127,7 +136,11 @@ class StopAction(gym.Wrapper):
                     f"confirm_stop_m reads HomingFeatures' home vector; got observations {space}"
                 )
         self.confirm_stop_m = confirm_stop_m
+        if not isinstance(head_scan, (bool, np.bool_)):
+            raise ValueError(f"head_scan must be True or False, got {head_scan!r}")
+        self.head_scan = bool(head_scan)
         self._pans = HEAD_SCAN_DEG
+        self._scan_i = 0
         self._n = inner.shape[0]
         self.action_space = spaces.Box(-1.0, 1.0, (3,), np.float32)
         self._max_hold = 10**5
@@ -136,7 +149,15 @@ class StopAction(gym.Wrapper):
 
     def reset(self, **kwargs):
         self._t = 0
+        self._scan_i = 0
         return self.env.reset(**kwargs)
+
+    def _next_pan(self) -> float:
+        """The head pan of the next step that does not walk forward (the scan goes on
+        across decisions, as the scripted agent's)."""
+        pan = self._pans[self._scan_i % len(self._pans)]
+        self._scan_i += 1
+        return float(pan)
 
     def _inner_action(self, forward: float, turn: float, pan_deg: float = 0.0) -> np.ndarray:
         a = np.zeros(self._n, np.float32)
@@ -148,9 +169,12 @@ class StopAction(gym.Wrapper):
         return a
 
     def _walk_action(self, forward: float, turn: float) -> np.ndarray:
-        """The task action of a walk decision, never one the task counts as standing still."""
+        """The task action of a walk decision, never one the task counts as standing still;
+        the head scans if it does not walk forward."""
         a = self._inner_action(forward, turn)
         task = self.env.unwrapped
+        if self.head_scan and abs(float(a[0])) <= task.still_threshold:
+            a = self._inner_action(forward, turn, self._next_pan())
         if task.is_still(a):
             a[2] = np.float32(np.copysign(min(2.0 * task.still_threshold, 1.0), turn))
         return a
@@ -168,7 +192,7 @@ class StopAction(gym.Wrapper):
             return obs, r, terminated, truncated, {**info, "task_steps": 1}
         total = 0.0
         for i in range(self._max_hold):
-            pan = self._pans[i % len(self._pans)]
+            pan = self._next_pan() if self.head_scan else self._pans[i % len(self._pans)]
             obs, r, terminated, truncated, info = self.env.step(self._inner_action(0.0, 0.0, pan))
             total += float(r)
             if terminated or truncated or self._left_home(obs):
@@ -190,6 +214,7 @@ def make_homing_env(
     max_turn_deg_s: float = 60.0,
     min_walk_s: float = 2.0,
     confirm_stop_m: float | None = None,
+    head_scan: bool = True,
     **task_kwargs: Any,
 ) -> gym.Env:
     """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
@@ -202,6 +227,8 @@ def make_homing_env(
         :class:`StopAction` settings.
     confirm_stop_m : float, optional
         :class:`StopAction`'s check of a stop while the robot stands.
+    head_scan : bool
+        :class:`StopAction` scans with the head in decisions that do not walk forward.
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
@@ -209,4 +236,4 @@ def make_homing_env(
     env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
     env = CompassObservation(env, keep_image=False, tracker=tracker)
     env = HomingFeatures(env)
-    return StopAction(env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m)
+    return StopAction(env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m, head_scan)
