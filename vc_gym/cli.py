@@ -63,6 +63,7 @@ _TRAIN_FIELDS = {
     "demo_episodes": "demo_episodes",
     "places": "places",
     "collector": "collector",
+    "closeness_bonus": "closeness_bonus",
 }
 
 
@@ -740,6 +741,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="warm start (ppo): clone the scripted expert's decisions in N homing episodes "
         "before PPO starts (DIR/warm_start.json; the clone is evaluated first); 0: from "
         "scratch, as with --algo sac (default 60)",
+    )
+    p.add_argument(
+        "--closeness-bonus",
+        type=float,
+        metavar="R",
+        help="reward of a successful stop for its closeness to home: R x (1 - distance / "
+        "success radius), on top of the success bonus (default 0: the task's rewards)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

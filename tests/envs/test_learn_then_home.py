@@ -117,6 +117,25 @@ def test_standing_still_for_stop_time_ends_the_episode(env, start, success):
         env.step(STILL)
 
 
+@pytest.mark.parametrize(("start", "success"), [((0.1, 0.1, 0.0), True), ((0.4, 0.0, 0.0), False)])
+def test_closeness_bonus_grows_towards_home(learner, start, success):
+    e = gym.make("vc_gym/LearnThenHome-v0", stop_time_s=0.5, closeness_bonus=6.0, learner=learner)
+    e.reset(seed=3, options={"pose": start})
+    for _ in range(5):
+        _, r, terminated, _, info = e.step(STILL)
+    e.close()
+    assert terminated and info["success"] is success
+    d = info["stop_error_m"]
+    assert d == pytest.approx(math.hypot(*start[:2]), abs=1e-3)
+    bonus = 10.0 + 6.0 * (1.0 - d / 0.3) if success else 0.0
+    assert r == pytest.approx(bonus, abs=1e-3)
+
+
+def test_closeness_bonus_is_checked():
+    with pytest.raises(ValueError, match="closeness_bonus"):
+        gym.make("vc_gym/LearnThenHome-v0", closeness_bonus=-1.0)
+
+
 def test_moving_resets_the_stop_clock_and_time_limit_truncates(learner):
     e = gym.make("vc_gym/LearnThenHome-v0", max_homing_s=3.0, stop_time_s=1.0, learner=learner)
     e.reset(seed=4, options={"pose": (1.0, 1.0, 0.0)})

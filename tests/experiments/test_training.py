@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
+import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -212,6 +213,8 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
         {"algo": "sac", "demo_episodes": 5},
         {"confirm_stop_m": 0.0},
         {"confirm_stop_m": float("inf")},
+        {"closeness_bonus": -1.0},
+        {"closeness_bonus": float("nan")},
     ],
 )
 def test_bad_train_config(kwargs):
@@ -252,6 +255,22 @@ def test_stops_are_checked_in_training_and_old_configs_keep_their_final_stops():
     # a config.json written before the field existed: its stops were final
     saved_before = {k: v for k, v in final.to_dict().items() if k != "confirm_stop_m"}
     assert TrainConfig.from_dict(saved_before) == final
+
+
+def test_training_rewards_closeness_and_old_configs_keep_the_task_rewards():
+    closer = replace(TINY, closeness_bonus=10.0)
+    assert closer.env_kwargs()["closeness_bonus"] == 10.0
+    assert TrainConfig.from_dict(closer.to_dict()) == closer
+    plain = replace(TINY, closeness_bonus=0.0)
+    assert "closeness_bonus" not in plain.env_kwargs()
+    assert TrainConfig.from_dict(plain.to_dict()) == plain
+    # a config.json written before the field existed: trained with the task's rewards
+    saved_before = {k: v for k, v in plain.to_dict().items() if k != "closeness_bonus"}
+    assert TrainConfig.from_dict(saved_before) == plain
+    # what the agent's env is built with
+    env = gym.make("vc_gym/Homing-v0", **closer.env_kwargs())
+    assert env.unwrapped.closeness_bonus == 10.0
+    env.close()
 
 
 def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):

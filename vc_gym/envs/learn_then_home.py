@@ -78,7 +78,9 @@ class LearnThenHomeEnv(gym.Env):
     While homing, each step earns ``progress_reward × (d_before − d_after)``, where
     ``d`` is the true distance from home in metres (walking 1 m closer earns
     ``progress_reward``, 10 by default). Stopping (standing still for ``stop_time_s``)
-    within ``success_radius_m`` of home adds ``success_bonus`` (10); falling costs
+    within ``success_radius_m`` of home adds ``success_bonus`` (10) and
+    ``closeness_bonus × (1 − d / success_radius_m)`` (default 0: a stop at home earns the
+    whole ``closeness_bonus``, one at the radius nothing); falling costs
     ``fall_penalty`` (10). The learning phase earns nothing; an agent that learned no
     frame ends the episode with ``-fall_penalty``.
 
@@ -145,6 +147,7 @@ class LearnThenHomeEnv(gym.Env):
         still_threshold: float = 0.05,
         progress_reward: float = 10.0,
         success_bonus: float = 10.0,
+        closeness_bonus: float = 0.0,
         fall_penalty: float = 10.0,
         max_spots: int = 8,
         spot_radius_m: float = 0.25,
@@ -174,6 +177,7 @@ class LearnThenHomeEnv(gym.Env):
             ("still_threshold", still_threshold),
             ("progress_reward", progress_reward),
             ("success_bonus", success_bonus),
+            ("closeness_bonus", closeness_bonus),
             ("fall_penalty", fall_penalty),
         ):
             nonnegative_float(name, v)
@@ -213,6 +217,7 @@ class LearnThenHomeEnv(gym.Env):
         self.still_threshold = float(still_threshold)
         self.progress_reward = float(progress_reward)
         self.success_bonus = float(success_bonus)
+        self.closeness_bonus = float(closeness_bonus)
         self.fall_penalty = float(fall_penalty)
         if atlas_file is not None:
             spec = {
@@ -388,7 +393,9 @@ class LearnThenHomeEnv(gym.Env):
         if terminated or truncated:
             success = stopped and not fell and d <= self.success_radius_m
             if success:
-                reward += self.success_bonus
+                reward += self.success_bonus + self.closeness_bonus * (
+                    1.0 - d / self.success_radius_m
+                )
             info.update(
                 stop_position=np.asarray(info["pose"][:2], np.float64),
                 stop_error_m=d,

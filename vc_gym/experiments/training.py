@@ -31,7 +31,7 @@ from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import make_tracker
 from vc_gym.persistence import write_atomic
-from vc_gym.validation import int_at_least, positive_float
+from vc_gym.validation import int_at_least, nonnegative_float, positive_float
 
 __all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
 
@@ -82,6 +82,13 @@ class TrainConfig:
         with the check it is evaluated with (README: 87 ± 5 % and 25.0 ± 4.6 cm on 99
         held-out kidnappings, against 86 ± 6 % and 27.1 ± 4.4 cm trained with final
         stops of 0.1 s). ``None``: a stop is final.
+    closeness_bonus : float
+        Reward of a successful stop for its closeness to home (``closeness_bonus`` of
+        ``vc_gym/LearnThenHome-v0``: ``closeness_bonus × (1 − d / success_radius_m)`` on
+        top of the success bonus). Default 0: the task's rewards, under which a stop
+        25 cm from home earns as much as one at home, less the 10 per metre of the
+        progress reward. A ``config.json`` saved before the field existed was trained
+        with 0.
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
     collector : str, optional
@@ -138,6 +145,7 @@ class TrainConfig:
     learn_time_s: float = 5.0
     stop_time_s: float = 5.0
     confirm_stop_m: float | None = LEARNED_CONFIRM_STOP_M
+    closeness_bonus: float = 0.0
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
@@ -193,6 +201,7 @@ class TrainConfig:
             positive_float(name, v)
         if self.confirm_stop_m is not None:
             positive_float("confirm_stop_m", self.confirm_stop_m)
+        nonnegative_float("closeness_bonus", self.closeness_bonus)
         if self.demo_episodes and self.algo != "ppo":
             raise ValueError("demo_episodes (the warm start) needs algo 'ppo'; use 0 with sac")
         if not (0 < self.gamma <= 1):
@@ -236,8 +245,11 @@ class TrainConfig:
 
     def env_kwargs(self) -> dict[str, Any]:
         """The ``vc_gym/Homing-v0`` arguments of this run (the agent's env)."""
-        # confirm_stop_m only when set, as configs saved before it existed have it
+        # confirm_stop_m and closeness_bonus only when set, as configs saved before they
+        # existed have them
         checked = {} if self.confirm_stop_m is None else {"confirm_stop_m": self.confirm_stop_m}
+        if self.closeness_bonus:
+            checked["closeness_bonus"] = self.closeness_bonus
         return {
             "scene": self.scene,
             "learn_time_s": self.learn_time_s,
@@ -263,6 +275,7 @@ class TrainConfig:
             raise ValueError(f"config schema {schema!r} is not {CONFIG_SCHEMA}")
         env = data.pop("env", None)
         data.setdefault("confirm_stop_m", None)
+        data.setdefault("closeness_bonus", 0.0)
         data.setdefault("collector", "lockstep")
         config = cls.from_settings(data)
         if env is not None and env != config.env_kwargs():
