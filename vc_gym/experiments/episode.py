@@ -21,7 +21,10 @@ import gymnasium as gym
 import numpy as np
 from tqdm import tqdm
 
+from vc_gym.agents.learned import LearnedHomingAgent
+from vc_gym.agents.scripted import ScriptedHomingPolicy
 from vc_gym.angles import wrap180
+from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
 
 __all__ = [
@@ -239,9 +242,6 @@ def make_homing_run(
     """
     chosen = homing_mode(mode)
     policy_kwargs = {**chosen.policy, **(policy or {})}
-    from vc_gym.agents.scripted import ScriptedHomingPolicy
-    from vc_gym.envs.compass_observation import CompassObservation
-
     task: dict[str, Any] = {
         "scene": scene,
         "relearn": relearn,
@@ -258,8 +258,6 @@ def make_homing_run(
         env = CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
         scripted = ScriptedHomingPolicy.for_env(env, **policy_kwargs)
         return HomingRun(env, scripted.predict, scripted.reset)
-    from vc_gym.agents.learned import LearnedHomingAgent
-
     learned = LearnedHomingAgent(agent)
     env = learned.make_env(tracker=tracker, confirm_stop_m=LEARNED_CONFIRM_STOP_M, **task)
     return HomingRun(env, learned.predict, None)

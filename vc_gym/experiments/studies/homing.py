@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.agents.learned import PRETRAINED_MODEL, LearnedHomingAgent
 from vc_gym.baselines import (
     IMAGE_SENSORS,
     SENSOR_GRID,
@@ -28,7 +29,9 @@ from vc_gym.baselines import (
     NoisyMagneticCompass,
 )
 from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.learning import HOME
+from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.episode import HOMING_MODES, homing_mode, make_homing_run, run_episode
 from vc_gym.experiments.output import new_figure, save_figure
@@ -40,6 +43,7 @@ from vc_gym.experiments.studies.common import (
     pick_size,
     scene_field_bounds,
 )
+from vc_gym.experiments.video import write_episode_video
 from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
 from vc_gym.localization import make_tracker
 from vc_gym.validation import positive_float
@@ -156,8 +160,6 @@ def episode_job(
     if magnetometer:
         _fit_magnetometer(run, learning_seed, episode_seed)
     if video is not None:
-        from vc_gym.experiments.video import write_episode_video
-
         record = write_episode_video(run, episode_seed, video)
     else:
         record = run_episode(run, seed=episode_seed)
@@ -190,8 +192,6 @@ def field_job(
     scene: str, atlas: str, x: float, y: float, headings: list[float], frames: int, seed: int
 ) -> dict[str, Any]:
     """Job: the mean normalised goodness of every spot at ``(x, y)`` (fig. 5 right)."""
-    from vc_gym.envs.aibo_room import AiboRoomEnv
-
     room = worker_cache(("room", scene), lambda: AiboRoomEnv(scene=scene))
     loaded = worker_cache(("atlas", atlas), lambda: CompassAtlas.load(atlas))
     camera = Camera(hfov_deg=room.camera.hfov_deg)
@@ -331,19 +331,13 @@ def run_homing(
     if sensor is not None:
         grid_options = _sensor_tracker_options(sensor, tracker, relearn)
     if agent == "pretrained":
-        from vc_gym.agents.learned import PRETRAINED_MODEL
-
         agent = str(PRETRAINED_MODEL)
     if agent != "scripted":
-        from vc_gym.agents.learned import LearnedHomingAgent
-
         agent = str(Path(agent).resolve())
         learned = LearnedHomingAgent(agent)  # a bad model fails here, not in a worker
         learned.check_env()  # and so does a config.json the env refuses
         scene = learned.scene
     else:
-        from vc_gym.envs.scenes import check_scene_name
-
         check_scene_name(scene)
 
     settings = {
