@@ -64,6 +64,7 @@ _TRAIN_FIELDS = {
     "places": "places",
     "collector": "collector",
     "closeness_bonus": "closeness_bonus",
+    "min_walk": "min_walk_m",
 }
 
 
@@ -748,6 +749,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="R",
         help="reward of a successful stop for its closeness to home: R x (1 - distance / "
         "success radius), on top of the success bonus (default 0: the task's rewards)",
+    )
+    p.add_argument(
+        "--min-walk",
+        type=float,
+        metavar="M",
+        help="stop requests are ignored until the robot has walked M metres by its own "
+        "forward commands (default 0)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

@@ -146,3 +146,25 @@ def test_the_head_scans_when_the_robot_does_not_walk_forward(head_scan):
 def test_head_scan_must_be_a_bool():
     with pytest.raises(ValueError, match="head_scan"):
         gym.make("vc_gym/Homing-v0", head_scan="yes", **FAST)
+
+
+def test_stop_requests_wait_until_the_robot_has_walked_min_walk_m():
+    env = gym.make("vc_gym/Homing-v0", min_walk_s=0.0, min_walk_m=0.18, stop_time_s=1.0, **FAST)
+    env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
+    turn_and_stop = np.array([0.0, 1.0, 1.0], np.float32)
+    for _ in range(5):  # stop requests without walking are walk decisions: here, turns
+        _, _, terminated, _, info = env.step(turn_and_stop)
+        assert not terminated and info["task_steps"] == 1
+    walk_and_stop = np.array([1.0, 0.0, 1.0], np.float32)
+    for _ in range(5):  # 0.4 m/s for 0.1 s each: 0.16 m after four, still a walk
+        _, _, terminated, _, info = env.step(walk_and_stop)
+        assert not terminated and info["task_steps"] == 1
+    _, _, terminated, _, info = env.step(np.array([0.0, 0.0, 1.0], np.float32))
+    assert terminated and info["task_steps"] == 10  # now the stop holds for the whole 1 s
+    # a new episode must walk again
+    env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
+    _, _, terminated, _, info = env.step(turn_and_stop)
+    assert not terminated and info["task_steps"] == 1
+    env.close()
+    with pytest.raises(ValueError, match="min_walk_m"):
+        gym.make("vc_gym/Homing-v0", min_walk_m=-0.1, **FAST)

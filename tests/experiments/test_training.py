@@ -215,6 +215,7 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
         {"confirm_stop_m": float("inf")},
         {"closeness_bonus": -1.0},
         {"closeness_bonus": float("nan")},
+        {"min_walk_m": -0.5},
     ],
 )
 def test_bad_train_config(kwargs):
@@ -257,19 +258,21 @@ def test_stops_are_checked_in_training_and_old_configs_keep_their_final_stops():
     assert TrainConfig.from_dict(saved_before) == final
 
 
-def test_training_rewards_closeness_and_old_configs_keep_the_task_rewards():
-    closer = replace(TINY, closeness_bonus=10.0)
-    assert closer.env_kwargs()["closeness_bonus"] == 10.0
-    assert TrainConfig.from_dict(closer.to_dict()) == closer
-    plain = replace(TINY, closeness_bonus=0.0)
-    assert "closeness_bonus" not in plain.env_kwargs()
+@pytest.mark.parametrize(("name", "value"), [("closeness_bonus", 10.0), ("min_walk_m", 0.5)])
+def test_optional_env_settings_and_old_configs_without_them(name, value):
+    assert getattr(TrainConfig(), name) == 0.0
+    given = replace(TINY, **{name: value})
+    assert given.env_kwargs()[name] == value
+    assert TrainConfig.from_dict(given.to_dict()) == given
+    plain = replace(TINY, **{name: 0.0})
+    assert name not in plain.env_kwargs()
     assert TrainConfig.from_dict(plain.to_dict()) == plain
-    # a config.json written before the field existed: trained with the task's rewards
-    saved_before = {k: v for k, v in plain.to_dict().items() if k != "closeness_bonus"}
+    # a config.json written before the field existed: trained without it
+    saved_before = {k: v for k, v in plain.to_dict().items() if k != name}
     assert TrainConfig.from_dict(saved_before) == plain
     # what the agent's env is built with
-    env = gym.make("vc_gym/Homing-v0", **closer.env_kwargs())
-    assert env.unwrapped.closeness_bonus == 10.0
+    env = gym.make("vc_gym/Homing-v0", **given.env_kwargs())
+    assert env.get_wrapper_attr(name) == value
     env.close()
 
 

@@ -34,6 +34,7 @@ def test_shipped_hyperparameters_are_vc_gym_train_defaults(algo):
     assert env["stop_time_s"] == d.stop_time_s and env["learn_time_s"] == d.learn_time_s
     assert env["confirm_stop_m"] == d.confirm_stop_m
     assert env.get("closeness_bonus", 0.0) == d.closeness_bonus
+    assert env.get("min_walk_m", 0.0) == d.min_walk_m
     assert env["scene"] == d.scene and env["atlas_file"].endswith(".npz")
     with pytest.raises(ValueError, match="ppo and sac"):
         zoo_hyperparams("dqn")

@@ -78,7 +78,10 @@ class StopAction(gym.Wrapper):
     zero for 50 steps in a row is all but impossible to learn by chance; one stop
     decision is easy. Stop requests in the first ``min_walk_s`` of an episode are
     ignored (the filters are still settling, and an untrained policy would otherwise
-    end most episodes within a step or two).
+    end most episodes within a step or two), and so are those before the robot has
+    walked ``min_walk_m`` by its own forward commands (default 0): right after a
+    kidnapping 2 m out, one view can look exactly like home (README, *Beyond the
+    paper*), and a policy that trusts it stops where it was put.
 
     Only the stop output ends an episode: a walk decision whose command is too small
     to count as moving for the task (``|forward|``, ``|turn|`` ≤ its ``still_threshold``)
@@ -115,6 +118,7 @@ class StopAction(gym.Wrapper):
         min_walk_s: float = 2.0,
         confirm_stop_m: float | None = None,
         head_scan: bool = True,
+        min_walk_m: float = 0.0,
     ):
         super().__init__(env)
         inner = env.action_space
@@ -128,6 +132,7 @@ class StopAction(gym.Wrapper):
         self.max_forward = positive_float("max_forward", max_forward)
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
         nonnegative_float("min_walk_s", min_walk_s)
+        self.min_walk_m = nonnegative_float("min_walk_m", min_walk_m)
         if confirm_stop_m is not None:
             positive_float("confirm_stop_m", confirm_stop_m)
             space = env.observation_space
@@ -146,9 +151,11 @@ class StopAction(gym.Wrapper):
         self._max_hold = 10**5
         self.min_walk_steps = int(round(min_walk_s / env.unwrapped.control_dt))
         self._t = 0
+        self._walked_m = 0.0
 
     def reset(self, **kwargs):
         self._t = 0
+        self._walked_m = 0.0
         self._scan_i = 0
         return self.env.reset(**kwargs)
 
@@ -185,10 +192,11 @@ class StopAction(gym.Wrapper):
             raise ValueError(f"action must be 3 finite numbers, got {action!r}")
         a = np.clip(a, -1.0, 1.0)
         self._t += 1
-        if a[2] <= STOP_THRESHOLD or self._t <= self.min_walk_steps:
-            obs, r, terminated, truncated, info = self.env.step(
-                self._walk_action(max(a[0], 0.0), a[1])
-            )
+        walking = self._t <= self.min_walk_steps or self._walked_m < self.min_walk_m
+        if a[2] <= STOP_THRESHOLD or walking:
+            forward = max(float(a[0]), 0.0)
+            obs, r, terminated, truncated, info = self.env.step(self._walk_action(forward, a[1]))
+            self._walked_m += forward * self.max_forward * self.env.unwrapped.control_dt
             return obs, r, terminated, truncated, {**info, "task_steps": 1}
         total = 0.0
         for i in range(self._max_hold):
@@ -215,6 +223,7 @@ def make_homing_env(
     min_walk_s: float = 2.0,
     confirm_stop_m: float | None = None,
     head_scan: bool = True,
+    min_walk_m: float = 0.0,
     **task_kwargs: Any,
 ) -> gym.Env:
     """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
@@ -229,6 +238,8 @@ def make_homing_env(
         :class:`StopAction`'s check of a stop while the robot stands.
     head_scan : bool
         :class:`StopAction` scans with the head in decisions that do not walk forward.
+    min_walk_m : float
+        :class:`StopAction` ignores stop requests until the robot has walked this far.
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
@@ -236,4 +247,6 @@ def make_homing_env(
     env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
     env = CompassObservation(env, keep_image=False, tracker=tracker)
     env = HomingFeatures(env)
-    return StopAction(env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m, head_scan)
+    return StopAction(
+        env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m, head_scan, min_walk_m
+    )

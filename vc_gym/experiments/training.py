@@ -89,6 +89,10 @@ class TrainConfig:
         25 cm from home earns as much as one at home, less the 10 per metre of the
         progress reward. A ``config.json`` saved before the field existed was trained
         with 0.
+    min_walk_m : float
+        Stop requests are ignored until the robot has walked this far by its own
+        forward commands (``min_walk_m`` of ``vc_gym/Homing-v0``). Default 0. A
+        ``config.json`` saved before the field existed was trained with 0.
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
     collector : str, optional
@@ -146,6 +150,7 @@ class TrainConfig:
     stop_time_s: float = 5.0
     confirm_stop_m: float | None = LEARNED_CONFIRM_STOP_M
     closeness_bonus: float = 0.0
+    min_walk_m: float = 0.0
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
@@ -202,6 +207,7 @@ class TrainConfig:
         if self.confirm_stop_m is not None:
             positive_float("confirm_stop_m", self.confirm_stop_m)
         nonnegative_float("closeness_bonus", self.closeness_bonus)
+        nonnegative_float("min_walk_m", self.min_walk_m)
         if self.demo_episodes and self.algo != "ppo":
             raise ValueError("demo_episodes (the warm start) needs algo 'ppo'; use 0 with sac")
         if not (0 < self.gamma <= 1):
@@ -245,11 +251,12 @@ class TrainConfig:
 
     def env_kwargs(self) -> dict[str, Any]:
         """The ``vc_gym/Homing-v0`` arguments of this run (the agent's env)."""
-        # confirm_stop_m and closeness_bonus only when set, as configs saved before they
-        # existed have them
+        # confirm_stop_m, closeness_bonus and min_walk_m only when set, as configs saved
+        # before they existed have them
         checked = {} if self.confirm_stop_m is None else {"confirm_stop_m": self.confirm_stop_m}
-        if self.closeness_bonus:
-            checked["closeness_bonus"] = self.closeness_bonus
+        for name in ("closeness_bonus", "min_walk_m"):
+            if getattr(self, name):
+                checked[name] = getattr(self, name)
         return {
             "scene": self.scene,
             "learn_time_s": self.learn_time_s,
@@ -276,6 +283,7 @@ class TrainConfig:
         env = data.pop("env", None)
         data.setdefault("confirm_stop_m", None)
         data.setdefault("closeness_bonus", 0.0)
+        data.setdefault("min_walk_m", 0.0)
         data.setdefault("collector", "lockstep")
         config = cls.from_settings(data)
         if env is not None and env != config.env_kwargs():
