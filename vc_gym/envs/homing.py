@@ -150,6 +150,7 @@ class StopAction(gym.Wrapper):
         self.action_space = spaces.Box(-1.0, 1.0, (3,), np.float32)
         self._max_hold = 10**5
         self.min_walk_steps = int(round(min_walk_s / env.unwrapped.control_dt))
+        self._full_step_m = self.max_forward * env.unwrapped.control_dt  # a full forward step
         self._t = 0
         self._walked_m = 0.0
 
@@ -196,7 +197,7 @@ class StopAction(gym.Wrapper):
         if a[2] <= STOP_THRESHOLD or walking:
             forward = max(float(a[0]), 0.0)
             obs, r, terminated, truncated, info = self.env.step(self._walk_action(forward, a[1]))
-            self._walked_m += forward * self.max_forward * self.env.unwrapped.control_dt
+            self._walked_m += forward * self._full_step_m
             return obs, r, terminated, truncated, {**info, "task_steps": 1}
         total = 0.0
         for i in range(self._max_hold):
