@@ -65,6 +65,8 @@ _TRAIN_FIELDS = {
     "collector": "collector",
     "closeness_bonus": "closeness_bonus",
     "min_walk": "min_walk_m",
+    "home_offset_episodes": "home_offset_episodes",
+    "home_offset_places": "home_offset_places",
 }
 
 
@@ -756,6 +758,23 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="M",
         help="stop requests are ignored until the robot has walked M metres by its own "
         "forward commands (default 0)",
+    )
+    p.add_argument(
+        "--home-offset-episodes",
+        type=int,
+        metavar="N",
+        help="before the warm start the scripted expert homes N times in each training "
+        "place and --home-offset-places more; the median of (tracker's position - true "
+        "position) at its stops becomes the policy's goal, so that it stops at the true "
+        "home, not where the tracker puts home (DIR/home_offset.json; default 10; 0: the "
+        "tracker's home)",
+    )
+    p.add_argument(
+        "--home-offset-places",
+        type=int,
+        metavar="K",
+        help="places learned only for that measurement (default 3): part of the tracker's "
+        "offset belongs to the place",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

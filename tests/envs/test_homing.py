@@ -168,3 +168,36 @@ def test_stop_requests_wait_until_the_robot_has_walked_min_walk_m():
     env.close()
     with pytest.raises(ValueError, match="min_walk_m"):
         gym.make("vc_gym/Homing-v0", min_walk_m=-0.1, **FAST)
+
+
+def test_home_offset_moves_the_goal_of_the_features():
+    offset = (0.1, -0.2)
+    plain = gym.make("vc_gym/Homing-v0", **FAST)
+    moved = gym.make("vc_gym/Homing-v0", home_offset_m=offset, **FAST)
+    a, _ = plain.reset(seed=3)
+    b, _ = moved.reset(seed=3)
+    for _ in range(3):
+        step = np.array([0.6, 0.3, 0.0], np.float32)
+        a, *_ = plain.step(step)
+        b, *_ = moved.step(step)
+    m = HomingFeatures.METRES_SCALE
+    c, s = a[HomingFeatures.HEADING]
+    ox, oy = offset
+    np.testing.assert_allclose(
+        b[HomingFeatures.POSITION] * m, a[HomingFeatures.POSITION] * m - offset, atol=1e-5
+    )
+    shift = (ox * c + oy * s, -ox * s + oy * c)  # the offset in the robot's frame
+    np.testing.assert_allclose(
+        b[HomingFeatures.HOME_VECTOR] * m, a[HomingFeatures.HOME_VECTOR] * m + shift, atol=1e-5
+    )
+    rest = slice(HomingFeatures.GOODNESS_START, None)
+    np.testing.assert_array_equal(b[rest], a[rest])
+    assert moved.get_wrapper_attr("home_offset_m") == offset
+    plain.close()
+    moved.close()
+
+
+@pytest.mark.parametrize("bad", [(1.2, 0.0), (float("nan"), 0.0), (0.1,), "0.1,0.2", (0.1, True)])
+def test_home_offset_must_be_a_nearby_point(bad):
+    with pytest.raises(ValueError, match="home_offset_m"):
+        gym.make("vc_gym/Homing-v0", home_offset_m=bad, **FAST)

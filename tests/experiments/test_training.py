@@ -28,6 +28,7 @@ TINY = TrainConfig(
     eval_episodes=2,
     save_freq=32,
     demo_episodes=0,
+    home_offset_episodes=0,
 )
 
 
@@ -370,3 +371,56 @@ def test_training_over_a_pool_of_places(tmp_path):
     # the agent's env is the task env of one place: the env arguments are the same
     agent = LearnedHomingAgent(tmp_path / "model.zip")
     assert agent.env_kwargs == config.env_kwargs()
+
+
+def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
+    config = replace(
+        TINY,
+        timesteps=32,
+        max_homing_s=20.0,  # the expert gets home and stops
+        eval_freq=0,
+        vec_env="dummy",
+        collector="lockstep",
+        home_offset_episodes=3,
+        home_offset_places=1,
+    )
+    assert config.home_offset_seeds == (0, 2_000_000)
+    summary = train(config, tmp_path, progress=False)
+    measured = json.loads((tmp_path / "home_offset.json").read_text())
+    assert summary["home_offset"] == measured and measured["episodes"] == 6
+    assert (
+        len(measured["per_place_m"]) == 2 and (tmp_path / "home-offset-place2000000.npz").is_file()
+    )
+    saved = json.loads((tmp_path / "config.json").read_text())
+    assert saved["home_offset_m"] == measured["home_offset_m"]
+    assert saved["env"]["home_offset_m"] == measured["home_offset_m"]
+    agent = LearnedHomingAgent(tmp_path / "model.zip")  # evaluated going to the same goal
+    env = agent.make_env()
+    assert env.get_wrapper_attr("home_offset_m") == pytest.approx(measured["home_offset_m"])
+    env.close()
+
+
+def test_goal_correction_settings():
+    assert TrainConfig().home_offset_episodes == 10 and TrainConfig().home_offset_places == 3
+    assert TrainConfig(seed=2).home_offset_seeds == (2, 2_000_032, 2_000_033, 2_000_034)
+    given = replace(TINY, home_offset_m=(0.05, -0.1))
+    assert given.env_kwargs()["home_offset_m"] == [0.05, -0.1]
+    assert TrainConfig.from_dict(json.loads(json.dumps(given.to_dict()))) == given
+    assert "home_offset_m" not in TINY.env_kwargs()
+    # a config.json written before the fields existed: trained towards the tracker's home
+    saved_before = {
+        k: v for k, v in TrainConfig().to_dict().items() if not k.startswith("home_offset")
+    }
+    old = TrainConfig.from_dict(saved_before)
+    assert old.home_offset_episodes == 0 and old.home_offset_m is None
+    for bad in (
+        {"home_offset_episodes": -1},
+        {"home_offset_places": 17},
+        {"home_offset_episodes": 1, "home_offset_places": 0},  # 1 episode: too few
+        {"home_offset_m": (2.0, 0.0)},
+        {"home_offset_m": (float("nan"), 0.0)},
+        {"home_offset_m": (0.1,)},
+        {"home_offset_m": "0.1,0.2"},
+    ):
+        with pytest.raises(ValueError, match="home_offset"):
+            TrainConfig(**bad)

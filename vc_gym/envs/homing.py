@@ -9,6 +9,7 @@ dropped, any tracker) → :class:`HomingFeatures` (one scaled feature vector) �
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import gymnasium as gym
@@ -18,11 +19,33 @@ from gymnasium import spaces
 from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.localization import TrackerSpec
-from vc_gym.validation import nonnegative_float, positive_float
+from vc_gym.validation import finite_real, nonnegative_float, positive_float
 
-__all__ = ["STOP_THRESHOLD", "HomingFeatures", "StopAction", "make_homing_env"]
+__all__ = [
+    "MAX_HOME_OFFSET_M",
+    "STOP_THRESHOLD",
+    "HomingFeatures",
+    "StopAction",
+    "home_offset",
+    "make_homing_env",
+]
 
 STOP_THRESHOLD = 0.5
+#: Largest ``home_offset_m`` accepted (metres): a correction of the tracker's home, not
+#: another goal (the success radius is 0.3 m).
+MAX_HOME_OFFSET_M = 1.0
+
+
+def home_offset(value: Any) -> tuple[float, float]:
+    """``home_offset_m`` checked: two finite numbers within :data:`MAX_HOME_OFFSET_M`."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 2:
+        raise ValueError(f"home_offset_m must be two numbers (x, y) in metres, got {value!r}")
+    x, y = (finite_real("home_offset_m", v) for v in value)
+    if math.hypot(x, y) > MAX_HOME_OFFSET_M:
+        raise ValueError(
+            f"home_offset_m must be within {MAX_HOME_OFFSET_M} m of home, got ({x}, {y})"
+        )
+    return x, y
 
 
 class HomingFeatures(gym.ObservationWrapper):
@@ -32,6 +55,12 @@ class HomingFeatures(gym.ObservationWrapper):
     log goodness / 5 (one per spot, clipped to ±5), head pan / 90°]``: all of order 1.
     The class attributes name the slices and scales (what an agent reading the vector
     uses instead of bare indices).
+
+    ``home_offset_m`` moves the goal the vector describes from the atlas' home to that
+    point (world frame, metres from it): the home vector points there and the position
+    is measured from there. A learned agent trained with it walks to, and stops at,
+    the point where its tracker's estimate really puts home (``vc-gym train``
+    measures it, :mod:`vc_gym.experiments.home_offset`). Default ``(0, 0)``.
     """
 
     HOME_VECTOR = slice(0, 2)
@@ -42,8 +71,9 @@ class HomingFeatures(gym.ObservationWrapper):
     METRES_SCALE = 2.0
     SPREAD_SCALE_DEG = 180.0
 
-    def __init__(self, env: gym.Env):
+    def __init__(self, env: gym.Env, home_offset_m: Any = (0.0, 0.0)):
         super().__init__(env)
+        self.home_offset_m = home_offset(home_offset_m)
         space = env.observation_space
         needed = {"home_vector", "heading", "heading_spread", "position", "goodness", "head"}
         if not isinstance(space, spaces.Dict) or not needed <= set(space.spaces):
@@ -54,12 +84,19 @@ class HomingFeatures(gym.ObservationWrapper):
 
     def observation(self, obs: dict[str, np.ndarray]) -> np.ndarray:
         g = np.log(np.maximum(obs["goodness"].astype(np.float64), 1e-12)) / 5.0
+        home_vector = obs["home_vector"].astype(np.float64)
+        position = obs["position"].astype(np.float64)
+        if self.home_offset_m != (0.0, 0.0):
+            ox, oy = self.home_offset_m
+            c, s = (float(v) for v in obs["heading"])  # (0, 0) before the atlas: no turn
+            home_vector = home_vector + (ox * c + oy * s, -ox * s + oy * c)  # world_to_body
+            position = position - self.home_offset_m
         f = np.concatenate(
             [
-                obs["home_vector"] / self.METRES_SCALE,
+                home_vector / self.METRES_SCALE,
                 obs["heading"],
                 obs["heading_spread"] / self.SPREAD_SCALE_DEG,
-                obs["position"] / self.METRES_SCALE,
+                position / self.METRES_SCALE,
                 np.clip(g, -5.0, 5.0),
                 obs["head"][:1] / 90.0,
             ]
@@ -225,6 +262,7 @@ def make_homing_env(
     confirm_stop_m: float | None = None,
     head_scan: bool = True,
     min_walk_m: float = 0.0,
+    home_offset_m: Any = (0.0, 0.0),
     **task_kwargs: Any,
 ) -> gym.Env:
     """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
@@ -241,13 +279,16 @@ def make_homing_env(
         :class:`StopAction` scans with the head in decisions that do not walk forward.
     min_walk_m : float
         :class:`StopAction` ignores stop requests until the robot has walked this far.
+    home_offset_m : (float, float)
+        :class:`HomingFeatures`' goal, relative to the atlas' home (world frame, m).
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
     """
+    home_offset_m = home_offset(home_offset_m)  # refused before a world is built
     env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
     env = CompassObservation(env, keep_image=False, tracker=tracker)
-    env = HomingFeatures(env)
+    env = HomingFeatures(env, home_offset_m)
     return StopAction(
         env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m, head_scan, min_walk_m
     )

@@ -105,7 +105,12 @@ def bench_train(
     if not collectors or any(c not in COLLECTORS for c in collectors):
         raise ValueError(f"collectors must be a non-empty subset of {COLLECTORS}, got {collectors}")
     config = TrainConfig(  # no warm start: only the training's own speed is measured
-        timesteps=timesteps, n_envs=n_envs, seed=seed, learn_time_s=learn_time_s, demo_episodes=0
+        timesteps=timesteps,
+        n_envs=n_envs,
+        seed=seed,
+        learn_time_s=learn_time_s,
+        demo_episodes=0,
+        home_offset_episodes=0,
     )
     runs = {}
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:

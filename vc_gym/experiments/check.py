@@ -181,6 +181,10 @@ def _bad_input_cases() -> list[Case]:
         "scene='nope'": lambda: gym.make("vc_gym/AiboRoom-v0", scene="nope"),
         "TrainConfig(timesteps=0)": lambda: TrainConfig(timesteps=0),
         "TrainConfig(algo='dqn')": lambda: TrainConfig(algo="dqn"),
+        "TrainConfig(home_offset_m=(5, 0))": lambda: TrainConfig(home_offset_m=(5.0, 0.0)),
+        "Homing-v0 home_offset_m=(nan, 0)": lambda: gym.make(
+            "vc_gym/Homing-v0", home_offset_m=(float("nan"), 0.0)
+        ),
         "tracker 'nope'": lambda: make_tracker("nope"),
     }
     cases = [

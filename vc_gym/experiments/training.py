@@ -24,9 +24,11 @@ from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
 from vc_gym.agents.safe_load import load_sb3_model
 from vc_gym.config_files import read_settings
+from vc_gym.envs.homing import home_offset
 from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.episode import LEARNED_CONFIRM_STOP_M
+from vc_gym.experiments.home_offset import MIN_STOPS, measure_home_offset
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import make_tracker
@@ -38,6 +40,13 @@ __all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
 CONFIG_SCHEMA = 2
 #: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
 DEFAULT_DEMO_EPISODES = {"ppo": 60, "sac": 0}
+#: Expert episodes that measure the goal correction by default
+#: (``TrainConfig.home_offset_episodes``).
+DEFAULT_HOME_OFFSET_EPISODES = 10
+#: Learning and kidnapping seeds of the offset measurement start here: apart from the
+#: training envs' (seed + i), the held-out evaluations' (``eval_seed``) and the learning
+#: seeds anyone evaluates on.
+HOME_OFFSET_SEED = 2_000_000
 #: Accepted values of ``TrainConfig.collector``.
 COLLECTORS = ("lockstep", "async")
 #: At most this many places per training run (each is a PyBullet world in every worker).
@@ -93,6 +102,23 @@ class TrainConfig:
         Stop requests are ignored until the robot has walked this far by its own
         forward commands (``min_walk_m`` of ``vc_gym/Homing-v0``). Default 0. A
         ``config.json`` saved before the field existed was trained with 0.
+    home_offset_episodes : int
+        Before the warm start, the scripted expert homes this many times in each of the
+        training place(s) and ``home_offset_places`` more, and the median ``estimate −
+        true position`` at its stops becomes the goal of the agent's env
+        (``home_offset_m`` of ``vc_gym/Homing-v0``; :mod:`vc_gym.experiments.home_offset`;
+        ``DIR/home_offset.json``): the policy learns to stop where the tracker's
+        estimate reads when the robot stands at the true home, not where the tracker
+        believes home is (README, *Learned agents*). Default 10; 0: the atlas' home. A
+        ``config.json`` saved before the field existed was trained with 0.
+    home_offset_places : int
+        Places learned only for that measurement (learning seeds
+        ``HOME_OFFSET_SEED + 16 × seed + k``, ``DIR/home-offset-place<s>.npz``): part of
+        the offset belongs to the place. Default 3.
+    home_offset_m : (float, float), optional
+        The goal correction itself (metres, world frame). ``None`` (default): measured
+        with ``home_offset_episodes``, or ``(0, 0)`` without; a run's ``config.json``
+        holds the measured value, so that its evaluation uses it.
     vec_env : str
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
     collector : str, optional
@@ -151,6 +177,9 @@ class TrainConfig:
     confirm_stop_m: float | None = LEARNED_CONFIRM_STOP_M
     closeness_bonus: float = 0.0
     min_walk_m: float = 0.0
+    home_offset_episodes: int = DEFAULT_HOME_OFFSET_EPISODES
+    home_offset_places: int = 3
+    home_offset_m: tuple[float, float] | None = None
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
     vec_env: str = "subproc"
@@ -208,6 +237,14 @@ class TrainConfig:
             positive_float("confirm_stop_m", self.confirm_stop_m)
         nonnegative_float("closeness_bonus", self.closeness_bonus)
         nonnegative_float("min_walk_m", self.min_walk_m)
+        int_at_least("home_offset_episodes", self.home_offset_episodes, 0)
+        int_at_least("home_offset_places", self.home_offset_places, 0)
+        if self.home_offset_places > MAX_PLACES:
+            raise ValueError(
+                f"home_offset_places must be at most {MAX_PLACES}, got {self.home_offset_places}"
+            )
+        if self.home_offset_m is not None:
+            object.__setattr__(self, "home_offset_m", home_offset(self.home_offset_m))
         if self.demo_episodes and self.algo != "ppo":
             raise ValueError("demo_episodes (the warm start) needs algo 'ppo'; use 0 with sac")
         if not (0 < self.gamma <= 1):
@@ -226,11 +263,26 @@ class TrainConfig:
                 f"places must be at most {MAX_PLACES} distinct learning seeds, got {places!r}"
             )
         object.__setattr__(self, "places", tuple(int(s) for s in places))
+        n_measured = self.home_offset_episodes * len(self.home_offset_seeds)
+        if 0 < n_measured < MIN_STOPS:
+            raise ValueError(
+                f"the home offset needs at least {MIN_STOPS} expert episodes, got "
+                f"home_offset_episodes={self.home_offset_episodes} in "
+                f"{len(self.home_offset_seeds)} place(s)"
+            )
 
     @property
     def place_seeds(self) -> tuple[int, ...]:
         """The learning seeds of the places trained in (``places``, or ``(seed,)``)."""
         return self.places or (self.seed,)
+
+    @property
+    def home_offset_seeds(self) -> tuple[int, ...]:
+        """The learning seeds of the places the goal correction is measured in."""
+        extra = (
+            HOME_OFFSET_SEED + MAX_PLACES * self.seed + k for k in range(self.home_offset_places)
+        )
+        return self.place_seeds + tuple(extra)
 
     def atlas_files(self, out_dir: str | os.PathLike) -> list[Path]:
         """Where the run in ``out_dir`` keeps each place's atlas (one per place seed)."""
@@ -246,17 +298,22 @@ class TrainConfig:
             **asdict(self),
             "net_arch": list(self.net_arch),
             "places": list(self.places),
+            "home_offset_m": None if self.home_offset_m is None else list(self.home_offset_m),
             "env": self.env_kwargs(),
         }
 
     def env_kwargs(self) -> dict[str, Any]:
         """The ``vc_gym/Homing-v0`` arguments of this run (the agent's env)."""
-        # confirm_stop_m, closeness_bonus and min_walk_m only when set, as configs saved
-        # before they existed have them
-        checked = {} if self.confirm_stop_m is None else {"confirm_stop_m": self.confirm_stop_m}
+        # confirm_stop_m, closeness_bonus, min_walk_m and home_offset_m only when set, as
+        # configs saved before they existed have them
+        checked: dict[str, Any] = {}
+        if self.confirm_stop_m is not None:
+            checked["confirm_stop_m"] = self.confirm_stop_m
         for name in ("closeness_bonus", "min_walk_m"):
             if getattr(self, name):
                 checked[name] = getattr(self, name)
+        if self.home_offset_m is not None and self.home_offset_m != (0.0, 0.0):
+            checked["home_offset_m"] = list(self.home_offset_m)
         return {
             "scene": self.scene,
             "learn_time_s": self.learn_time_s,
@@ -284,6 +341,8 @@ class TrainConfig:
         data.setdefault("confirm_stop_m", None)
         data.setdefault("closeness_bonus", 0.0)
         data.setdefault("min_walk_m", 0.0)
+        data.setdefault("home_offset_episodes", 0)
+        data.setdefault("home_offset_places", 0)
         data.setdefault("collector", "lockstep")
         config = cls.from_settings(data)
         if env is not None and env != config.env_kwargs():
@@ -470,8 +529,9 @@ def train(
     episodes: list[dict[str, Any]] = []
     checkpoint = None
     warm_start: dict[str, Any] | None = None
+    offset: dict[str, Any] | None = None
     if resume:
-        checkpoint, episodes = _resume_state(out, config)
+        checkpoint, episodes, config = _resume_state(out, config)
     out = check_out_dir(out)
     write_json(out / "config.json", config.to_dict())
     t0 = time.perf_counter()
@@ -479,6 +539,13 @@ def train(
         seeds = ", ".join(map(str, config.place_seeds))
         print(f"learning each place once ({config.scene}, learning seeds {seeds}) -> {out}")
     learn_places(config, out)
+    if config.home_offset_m is None and config.home_offset_episodes:
+        if progress:
+            print(
+                f"measuring the tracker's home: {config.home_offset_episodes} expert episodes "
+                f"in each of {len(config.home_offset_seeds)} places"
+            )
+        config, offset = _measure_goal(config, out, progress)
     (out / "monitor").mkdir(exist_ok=True)
     factories = [
         _EnvFactory(config, i, out, out / "monitor" / str(i), append=resume)
@@ -569,6 +636,7 @@ def train(
         "episodes": len(episodes),
         "resumed_from": None if checkpoint is None else str(checkpoint),
         "warm_start": warm_start,
+        "home_offset": offset,
         "best_model": str(out / "best" / "best_model.zip")
         if (out / "best" / "best_model.zip").is_file()
         else None,
@@ -581,6 +649,31 @@ def train(
     if episodes:
         _plot_curve(out / "learning_curve.png", episodes, config)
     return summary
+
+
+def _measure_goal(
+    config: TrainConfig, out: Path, progress: bool
+) -> tuple[TrainConfig, dict[str, Any]]:
+    """Measure the run's goal correction (:mod:`.home_offset`) and keep it in the run
+    folder (``home_offset.json``, ``config.json``); the config to train with."""
+    files = {s: f for s, f in _places(config, out)}
+    envs = []  # each place going to its atlas' home; the extra ones learned here
+    try:
+        for s in config.home_offset_seeds:
+            envs.append(_place_env(config, s, files.get(s, out / f"home-offset-place{s}.npz")))
+        measured = measure_home_offset(
+            envs,
+            config.home_offset_episodes,
+            HOME_OFFSET_SEED + MAX_PLACES * config.seed,
+            progress=progress,
+        )
+    finally:
+        for env in envs:
+            env.close()
+    config = replace(config, home_offset_m=measured.offset_m)
+    write_json(out / "home_offset.json", measured.to_dict())
+    write_json(out / "config.json", config.to_dict())
+    return config, measured.to_dict()
 
 
 def _warm_start(model: Any, venv: Any, config: TrainConfig, progress: bool) -> dict[str, Any]:
@@ -613,12 +706,15 @@ def _algo_kwargs(config: TrainConfig) -> dict[str, Any]:
     return kwargs
 
 
-def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, Any]]]:
-    """The checkpoint to continue from and the episodes logged so far (checked first)."""
+def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, Any]], TrainConfig]:
+    """The checkpoint to continue from, the episodes logged so far and the config to go
+    on with (``config`` with the run's measured ``home_offset_m``), checked first."""
     saved_path = out / "config.json"
     if not saved_path.is_file():
         raise ValueError(f"{out}: no config.json, nothing to resume")
     saved = read_train_config(saved_path)
+    if config.home_offset_m is None:  # the run measured it: keep the measurement
+        config = replace(config, home_offset_m=saved.home_offset_m)
     if replace(saved, timesteps=config.timesteps) != config:
         raise ValueError(
             f"{saved_path}: the run was started with other settings; resume it with the "
@@ -636,7 +732,7 @@ def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, 
         except (OSError, ValueError, KeyError, TypeError, RecursionError) as exc:
             raise ValueError(f"{log_path}: unreadable training log: {exc}") from None
         episodes = [e for e in logged if isinstance(e, dict) and e.get("timestep", 0) <= steps]
-    return checkpoint, episodes
+    return checkpoint, episodes, config
 
 
 def _plot_curve(path: Path, episodes: list[dict[str, Any]], config: TrainConfig) -> None:

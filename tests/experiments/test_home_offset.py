@@ -1,0 +1,122 @@
+"""Measuring where the tracker's estimate puts home, with a tracker whose error is known."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import vc_gym  # noqa: F401
+from vc_gym.envs.homing import HomingFeatures
+from vc_gym.experiments.home_offset import MIN_STOPS, measure_home_offset
+from vc_gym.localization import TrackerState
+
+FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0, "stop_time_s": 0.3, "min_walk_s": 0.0}
+BIAS = (0.12, -0.07)
+
+
+class BiasedOracle:
+    """A tracker that reads the robot's true pose and reports its position off by
+    ``bias`` (a tracker whose home lies at ``-bias`` from the true one)."""
+
+    def __init__(self, bias=BIAS):
+        self.bias = np.asarray(bias, np.float64)
+        self.room = None  # set once the env exists
+
+    def reset(self, atlas, camera, dt_s):
+        self.n_spots = len(atlas)
+
+    def update(self, image, head_pan_deg, odometry):
+        x, y, yaw = self.room.robot.pose
+        belief = np.full(36, 1 / 36)
+        return TrackerState(
+            heading_deg=float(yaw) % 360.0,
+            heading_spread_deg=1.0,
+            position=(float(x + self.bias[0]), float(y + self.bias[1])),
+            position_std_m=(0.01, 0.01),
+            goodness=np.ones(self.n_spots),
+            belief=belief,
+            atlas_position=(float(x), float(y)),
+        )
+
+
+class StopAtOnce:
+    """An "expert" that stops wherever it stands (its stops lie where it was put)."""
+
+    def predict(self, features):
+        return np.array([-1.0, 0.0, 1.0], np.float32)
+
+
+@pytest.fixture(scope="module")
+def place(tmp_path_factory):
+    """One place's atlas file, learned once for every env of this module."""
+    return {"atlas_file": str(tmp_path_factory.mktemp("place") / "p.npz"), "learning_seed": 0}
+
+
+@pytest.fixture
+def make(place):
+    envs = []
+
+    def build(tracker, **kwargs):
+        env = gym.make("vc_gym/Homing-v0", tracker=lambda: tracker, **FAST, **place, **kwargs)
+        tracker.room = env.unwrapped.room
+        envs.append(env)
+        return env
+
+    yield build
+    for env in envs:
+        env.close()
+
+
+def test_the_offset_is_the_trackers_error_at_the_stops(make):
+    measured = measure_home_offset(make(BiasedOracle()), MIN_STOPS, seed=3, expert=StopAtOnce())
+    np.testing.assert_allclose(measured.offset_m, BIAS, atol=1e-6)
+    np.testing.assert_allclose(measured.spread_m, (0.0, 0.0), atol=1e-6)
+    assert measured.stops == measured.episodes == MIN_STOPS
+    d = measured.to_dict()
+    assert d["home_offset_m"] == [0.12, -0.07] and d["stops"] == MIN_STOPS
+    assert d["per_place_m"] == [[0.12, -0.07]]
+
+
+def test_places_are_pooled_and_reported_one_by_one(make):
+    envs = [make(BiasedOracle((0.1, 0.0))), make(BiasedOracle((0.3, -0.2)))]
+    measured = measure_home_offset(envs, 3, seed=0, expert=StopAtOnce())
+    np.testing.assert_allclose(measured.offset_m, (0.2, -0.1), atol=1e-6)  # median of 6
+    np.testing.assert_allclose(measured.per_place_m, [(0.1, 0.0), (0.3, -0.2)], atol=1e-6)
+    np.testing.assert_allclose(measured.spread_m, (0.1, 0.1), atol=1e-6)
+    assert measured.episodes == measured.stops == 6
+
+
+def test_with_the_measured_offset_the_goal_is_the_true_home(make):
+    env = make(BiasedOracle(), home_offset_m=BIAS)
+    obs, _ = env.reset(seed=4, options={"pose": (0.0, 0.0, 130.0)})  # at the true home
+    home = obs[HomingFeatures.HOME_VECTOR] * HomingFeatures.METRES_SCALE
+    position = obs[HomingFeatures.POSITION] * HomingFeatures.METRES_SCALE
+    assert np.hypot(*home) < 0.02 and np.hypot(*position) < 0.02
+    plain = make(BiasedOracle())  # without it the tracker's home is 14 cm away
+    obs, _ = plain.reset(seed=4, options={"pose": (0.0, 0.0, 130.0)})
+    home = obs[HomingFeatures.HOME_VECTOR] * HomingFeatures.METRES_SCALE
+    assert np.hypot(*home) == pytest.approx(np.hypot(*BIAS), abs=0.02)
+
+
+def test_bad_measurements_are_refused(make):
+    with pytest.raises(ValueError, match="home_offset_m is \\(0, 0\\)"):
+        measure_home_offset(make(BiasedOracle(), home_offset_m=(0.1, 0.0)), 5, seed=0)
+    env = make(BiasedOracle())
+    for bad in (0, 2.5, True):
+        with pytest.raises(ValueError, match="episodes"):
+            measure_home_offset(env, bad, seed=0)
+    with pytest.raises(ValueError, match="at least one env"):
+        measure_home_offset([], 5, seed=0)
+    with pytest.raises(ValueError, match="Homing-v0"):
+        measure_home_offset(gym.make("CartPole-v1"), MIN_STOPS, seed=0)
+
+    class NeverStops:
+        def predict(self, features):
+            return np.array([0.5, 0.0, -1.0], np.float32)
+
+    with pytest.raises(ValueError, match="stopped in only 0 of 5"):
+        measure_home_offset(env, MIN_STOPS, seed=0, expert=NeverStops())
+    lost = make(BiasedOracle(bias=(1.5, 0.0)))
+    with pytest.raises(ValueError, match="lost"):
+        measure_home_offset(lost, MIN_STOPS, seed=0, expert=StopAtOnce())
