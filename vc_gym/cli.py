@@ -316,6 +316,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "light": getattr(args, "light", None),
         "data_dir": getattr(args, "data", None),
         "sensor": getattr(args, "sensor", None),
+        "home_offset_m": getattr(args, "home_offset", None),
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -334,6 +335,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
                 "learn_time_s": "learn-time",
                 "max_homing_s": "max-homing",
                 "data_dir": "data",
+                "home_offset_m": "home-offset",
             }.get(name, name)
             raise ValueError(f"experiment {args.name} does not take {flag}")
         options[name] = value
@@ -501,6 +503,16 @@ def _int_list(text: str) -> list[int]:
         raise argparse.ArgumentTypeError(
             f"expected integers separated by commas: {text!r}"
         ) from None
+
+
+def _float_pair(text: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 2:
+        raise argparse.ArgumentTypeError(f"expected two numbers X,Y: {text!r}")
+    return values
 
 
 def _str_list(text: str) -> list[str]:
@@ -954,6 +966,14 @@ def build_parser() -> argparse.ArgumentParser:
         "every learning seed (position still from the atlas): feature, image_difference, "
         "sector_colour, visual_compass, or magnetic (a magnetometer in the head; see "
         "`vc-gym experiment sensors`)",
+    )
+    p.add_argument(
+        "--home-offset",
+        type=_float_pair,
+        metavar="X,Y",
+        help="homing: the scripted agent's goal relative to the tracker's home, in metres "
+        "(world frame), e.g. a learned agent's measured home_offset_m from its config.json; "
+        "write --home-offset=-0.07,0.10 when X is negative (default 0,0: the paper's)",
     )
     p.add_argument("--episodes", type=int, help="kidnappings per learning seed (paper: 33)")
     p.add_argument(

@@ -165,3 +165,41 @@ def test_verify_home_at_home_stops_after_one_turn():
 def test_bad_verification_parameters(kwargs):
     with pytest.raises(ValueError):
         ScriptedHomingPolicy(velocity, **kwargs)
+
+
+class BiasedWorld(AliasingWorld):
+    """A kinematic robot whose tracker reports its true position off by ``bias``: the
+    tracker's home lies at ``-bias``."""
+
+    def __init__(self, x, y, heading_deg, bias):
+        super().__init__(x, y, heading_deg)
+        self.bias = bias
+
+    def obs(self, odometry=(0.0, 0.0, 0.0)):
+        px, py = self.x + self.bias[0], self.y + self.bias[1]
+        th = np.radians(self.h)
+        fwd, left = -px * np.cos(th) - py * np.sin(th), px * np.sin(th) - py * np.cos(th)
+        return {
+            "home_vector": np.array([fwd, left]),
+            "heading_spread": np.array([2.0]),
+            "heading": np.array([np.cos(th), np.sin(th)]),
+            "odometry": np.array(odometry, np.float64),
+        }
+
+
+@pytest.mark.parametrize("verify_home", [False, True])
+def test_home_offset_makes_the_goal_the_true_home(verify_home):
+    bias = (0.15, -0.2)
+    world = BiasedWorld(1.0, -0.5, 90.0, bias)
+    assert run_until_still(policy(settle_time_s=0.0, verify_home=verify_home), world)
+    assert np.hypot(world.x + bias[0], world.y + bias[1]) <= 0.1  # at the tracker's home
+    world = BiasedWorld(1.0, -0.5, 90.0, bias)
+    p = policy(settle_time_s=0.0, verify_home=verify_home, home_offset_m=bias)
+    assert run_until_still(p, world)
+    assert np.hypot(world.x, world.y) <= 0.1  # at the true home
+
+
+@pytest.mark.parametrize("bad", [(2.0, 0.0), (float("nan"), 0.0), (0.1,), "0,0"])
+def test_home_offset_must_be_a_nearby_point(bad):
+    with pytest.raises(ValueError, match="home_offset_m"):
+        policy(home_offset_m=bad)

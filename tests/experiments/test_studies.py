@@ -130,6 +130,35 @@ def test_homing_with_a_baseline_as_the_heading_sensor(homing_quick, tmp_path, se
     assert job["kwargs"]["tracker"]["sensor_file"] == str(saved.resolve())
 
 
+def test_the_scripted_agent_can_go_to_a_corrected_goal(homing_quick, tmp_path, capsys):
+    out = tmp_path / "goal"
+    argv = [
+        "experiment",
+        "homing",
+        "--out",
+        str(out),
+        *QUICK,
+        "--atlas",
+        str(homing_quick / "atlases"),
+    ]
+    assert main([*argv, "--home-offset=-0.1,0.05", "--json"]) == 0
+    r = json.loads((out / "results.json").read_text())
+    assert r["settings"]["home_offset_m"] == [-0.1, 0.05] and r["overall"]["episodes"] == 2
+    job = json.loads(next((out / "jobs" / "episodes").glob("*.json")).read_text())
+    assert job["kwargs"]["home_offset_m"] == [-0.1, 0.05]
+    plain = json.loads((homing_quick / "results.json").read_text())["per_episode"]
+    moved = r["per_episode"]  # the same kidnappings, another goal: other stops
+    assert [e["start_pose"] for e in moved] == [e["start_pose"] for e in plain]
+    assert [e["stop_offset_m"] for e in moved] != [e["stop_offset_m"] for e in plain]
+    capsys.readouterr()
+    bad = ["experiment", "homing", "--out", str(tmp_path / "bad"), *QUICK]
+    assert main([*bad, "--agent", "pretrained", "--home-offset=0.1,0"]) == 2
+    assert "brings its own" in capsys.readouterr().err
+    assert main([*bad, "--home-offset=3,0"]) == 2
+    assert "within 1.0 m" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()
+
+
 def test_homing_results_and_video(homing_quick):
     r = json.loads((homing_quick / "results.json").read_text())
     assert [e["seed"] for e in r["per_episode"]] == [1, 2]

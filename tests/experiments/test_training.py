@@ -292,6 +292,8 @@ def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
     summary = r["over_seeds"]["eval_final_mean_return"]
     assert summary["n"] == 2 and summary["mean"] == pytest.approx(np.mean(returns), abs=1e-3)
     assert summary["std"] == pytest.approx(np.std(returns, ddof=1), abs=1e-3)
+    assert r["runs"]["seed-0"]["home_offset_x_m"] is None  # trained towards the tracker's home
+    assert r["over_seeds"]["home_offset_x_m"]["n"] == 0
     before = (out / "results.json").read_bytes()
     assert main(argv) == 0  # resumed: nothing trained again, the same figures
     assert (out / "results.json").read_bytes() == before

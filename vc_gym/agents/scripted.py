@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from vc_gym.envs.homing import home_offset
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.poses import body_to_world, world_to_body
 from vc_gym.validation import nonnegative_float, positive_float
@@ -71,6 +72,12 @@ class ScriptedHomingPolicy:
         Full turns at most per episode; after the last one the robot stops.
     verify_turn_deg_s : float
         Turn rate of the checking turn.
+    home_offset_m : (float, float)
+        The goal, relative to the tracker's home (world frame, metres): the policy walks
+        to and stops where the estimate reads this. Default ``(0, 0)``, the paper's. A
+        learned agent's training measures one (``home_offset_m`` of its
+        ``config.json``, :mod:`vc_gym.experiments.home_offset`); giving the scripted
+        agent the same shows what the goal alone is worth.
     """
 
     def __init__(
@@ -87,6 +94,7 @@ class ScriptedHomingPolicy:
         verify_gain: float = 1.5,
         max_verifications: int = 4,
         verify_turn_deg_s: float = 60.0,
+        home_offset_m: tuple[float, float] = (0.0, 0.0),
     ):
         if not callable(velocity_action):
             raise ValueError(f"velocity_action must be callable, got {velocity_action!r}")
@@ -127,6 +135,7 @@ class ScriptedHomingPolicy:
         self.verify_gain = float(verify_gain)
         self.max_verifications = max_verifications
         self.verify_turn_deg_s = float(verify_turn_deg_s)
+        self.home_offset_m = home_offset(home_offset_m)
         self.reset()
 
     @classmethod
@@ -158,7 +167,7 @@ class ScriptedHomingPolicy:
         """The action (``Box(-1, 1, (5,))`` of the env) for one observation."""
         if self.verify_home and self.phase != "walk":
             return self._verifying(obs)
-        fwd_home, left_home = (float(v) for v in obs["home_vector"])
+        fwd_home, left_home = self._home_vector(obs)
         spread = float(obs["heading_spread"][0])
         settling = self._t * self.dt_s < self.settle_time_s or spread > self.max_spread_deg
         self._t += 1
@@ -177,6 +186,17 @@ class ScriptedHomingPolicy:
             self._scan_i = (self._scan_i + 1) % len(pans)
             pan = pans[self._scan_i]
         return self.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
+
+    def _home_vector(self, obs: dict[str, np.ndarray]) -> tuple[float, float]:
+        """The goal in the robot's frame: the home vector moved by ``home_offset_m``."""
+        fwd, left = (float(v) for v in obs["home_vector"])
+        if self.home_offset_m == (0.0, 0.0):
+            return fwd, left
+        c, s = (float(v) for v in obs["heading"])
+        dx, dy = self.home_offset_m
+        th = math.degrees(math.atan2(s, c))
+        ox, oy = world_to_body(dx, dy, th)
+        return fwd + ox, left + oy
 
     def _walk_towards(self, fwd: float, left: float) -> tuple[float, float]:
         """Forward speed and turn rate towards a robot-frame point (the paper's gait)."""
@@ -198,7 +218,7 @@ class ScriptedHomingPolicy:
                 self._turned_deg += abs(float(obs["odometry"][2]))
                 c, s = (float(v) for v in obs["heading"])
                 heading = math.degrees(math.atan2(s, c))
-                self._offsets.append(body_to_world(*map(float, obs["home_vector"]), heading))
+                self._offsets.append(body_to_world(*self._home_vector(obs), heading))
             if self._turned_deg < 360.0:
                 return self.velocity_action(turn_deg_s=self.verify_turn_deg_s, pan_deg=0.0)
             # the turn is complete only after an observation, so ``heading`` is this one's

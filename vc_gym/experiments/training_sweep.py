@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from vc_gym.experiments.runner import ExperimentRun, Job
-from vc_gym.experiments.training import TrainConfig, train
+from vc_gym.experiments.training import TrainConfig, read_train_config, train
 
 __all__ = ["FIGURES", "train_job", "run_train_sweep"]
 
@@ -31,6 +31,8 @@ FIGURES = (
     "eval_final_mean_return",
     "eval_best_mean_return",
     "eval_final_success_rate",
+    "home_offset_x_m",
+    "home_offset_y_m",
 )
 
 
@@ -51,6 +53,14 @@ def _evaluation_figures(run_dir: Path) -> dict[str, float | None]:
         if "successes" in ev.files and ev["successes"].size:
             out["eval_final_success_rate"] = round(float(np.mean(ev["successes"][-1])), 4)
     return out
+
+
+def _goal_figures(run_dir: Path) -> dict[str, float | None]:
+    """The goal correction the run measured and trained with (its ``config.json``)."""
+    path = run_dir / "config.json"
+    offset = read_train_config(path).home_offset_m if path.is_file() else None
+    x, y = (None, None) if offset is None else offset
+    return {"home_offset_x_m": x, "home_offset_y_m": y}
 
 
 def train_job(config: dict[str, Any], out_dir: str) -> dict[str, Any]:
@@ -112,7 +122,10 @@ def run_train_sweep(
     ]
     outputs = run.run("train", jobs)
     runs = {
-        f"seed-{s}": {k: v for k, v in o.items() if k != "timing"}
+        f"seed-{s}": {
+            **{k: v for k, v in o.items() if k != "timing"},
+            **_goal_figures(out / f"seed-{s}"),
+        }
         for s, o in zip(seeds, outputs, strict=True)
         if o is not None
     }

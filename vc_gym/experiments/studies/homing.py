@@ -30,6 +30,7 @@ from vc_gym.baselines import (
 )
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.homing import home_offset
 from vc_gym.envs.learning import HOME
 from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
@@ -123,6 +124,9 @@ def _run_for(kwargs: Mapping[str, Any]):
         learner=SavedAtlas(atlas) if atlas else None,
         keep_image=kwargs.get("video") is not None,
         mode=kwargs.get("mode", "paper"),
+        policy=None
+        if kwargs.get("home_offset_m") is None
+        else {"home_offset_m": tuple(kwargs["home_offset_m"])},
     )
     if atlas:
         run.env.reset(seed=kwargs["learning_seed"])  # loads the saved atlas
@@ -142,6 +146,7 @@ def episode_job(
     video: str | None = None,
     mode: str = "paper",
     magnetometer: bool = False,
+    home_offset_m: list[float] | None = None,
 ) -> dict[str, Any]:
     """Job: one kidnapping (seed ``episode_seed``) with the saved ``atlas``.
 
@@ -150,7 +155,8 @@ def episode_job(
     a saved atlas brings its own learning). With ``magnetometer`` the grid tracker's
     heading sensor is a magnetometer in the robot's head (the disturbance field of
     :meth:`NoisyMagneticCompass.random_field` seeded by the learning seed, its noise by
-    the episode's). Returns the episode's figures.
+    the episode's). ``home_offset_m``: the scripted agent's goal correction. Returns the
+    episode's figures.
     """
     kwargs = dict(locals())
     cache_key = json.dumps(
@@ -262,6 +268,7 @@ def run_homing(
     field: bool = True,
     mode: str = "paper",
     sensor: str | None = None,
+    home_offset_m: Sequence[float] | None = None,
 ) -> dict[str, Any]:
     """Run the homing experiment and write ``results.json``, ``run.json`` and plots.
 
@@ -302,6 +309,10 @@ def run_homing(
         position still comes from the atlas. ``"magnetic"``: a magnetometer in the
         robot's head (:class:`~vc_gym.baselines.MagnetometerCompass`, nothing learned).
         Needs the grid tracker.
+    home_offset_m : (float, float), optional
+        The scripted agent's goal relative to the tracker's home (world frame, m;
+        ``ScriptedHomingPolicy(home_offset_m)``), e.g. a learned agent's measured one,
+        to see what that goal alone is worth. A learned agent brings its own.
 
     Returns
     -------
@@ -330,6 +341,13 @@ def run_homing(
     tracker = check_tracker_spec(tracker)
     if sensor is not None:
         grid_options = _sensor_tracker_options(sensor, tracker, relearn)
+    if home_offset_m is not None:
+        if agent != "scripted":
+            raise ValueError(
+                "home_offset_m is the scripted agent's goal; a learned agent brings its own "
+                "(its config.json)"
+            )
+        home_offset_m = list(home_offset(home_offset_m))
     if agent == "pretrained":
         agent = str(PRETRAINED_MODEL)
     if agent != "scripted":
@@ -353,6 +371,7 @@ def run_homing(
         "field": field,
         **({"mode": mode} if mode != "paper" else {}),
         **({"sensor": sensor} if sensor else {}),
+        **({"home_offset_m": home_offset_m} if home_offset_m is not None else {}),
         **(
             {"sensor_frames": SENSOR_FRAMES[opts.size]}
             if sensor is not None and sensor != MAGNETIC
@@ -391,6 +410,7 @@ def run_homing(
                 "episode_seed": s + 1 + i,
                 **({"mode": mode} if mode != "paper" else {}),
                 **({"magnetometer": True} if sensor == MAGNETIC else {}),
+                **({"home_offset_m": home_offset_m} if home_offset_m is not None else {}),
             }
             if n < opts.video:
                 kwargs["video"] = str((videos / f"seed{s}-episode{i:03d}.mp4").resolve())
