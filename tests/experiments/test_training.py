@@ -384,7 +384,7 @@ def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
         vec_env="dummy",
         collector="lockstep",
         home_offset_episodes=3,
-        home_offset_places=1,
+        home_offset_places=1,  # TINY keeps a checkpoint every 32 decisions
     )
     assert config.home_offset_seeds == (0, 2_000_000)
     summary = train(config, tmp_path, progress=False)
@@ -400,6 +400,11 @@ def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
     env = agent.make_env()
     assert env.get_wrapper_attr("home_offset_m") == pytest.approx(measured["home_offset_m"])
     env.close()
+    # resumed with the same settings: the run's measured goal is kept, not measured again
+    resumed = train(replace(config, timesteps=64), tmp_path, progress=False, resume=True)
+    assert resumed["home_offset"] is None and resumed["resumed_from"] is not None
+    again = json.loads((tmp_path / "config.json").read_text())
+    assert again["home_offset_m"] == measured["home_offset_m"] and again["timesteps"] == 64
 
 
 def test_goal_correction_settings():
