@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from vc_gym.envs.homing import home_offset
+from vc_gym.envs.homing import goal_vector, home_offset
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.poses import body_to_world, world_to_body
 from vc_gym.validation import nonnegative_float, positive_float
@@ -189,14 +189,10 @@ class ScriptedHomingPolicy:
 
     def _home_vector(self, obs: dict[str, np.ndarray]) -> tuple[float, float]:
         """The goal in the robot's frame: the home vector moved by ``home_offset_m``."""
-        fwd, left = (float(v) for v in obs["home_vector"])
         if self.home_offset_m == (0.0, 0.0):
+            fwd, left = (float(v) for v in obs["home_vector"])
             return fwd, left
-        c, s = (float(v) for v in obs["heading"])
-        dx, dy = self.home_offset_m
-        th = math.degrees(math.atan2(s, c))
-        ox, oy = world_to_body(dx, dy, th)
-        return fwd + ox, left + oy
+        return goal_vector(obs["home_vector"], obs["heading"], self.home_offset_m)
 
     def _walk_towards(self, fwd: float, left: float) -> tuple[float, float]:
         """Forward speed and turn rate towards a robot-frame point (the paper's gait)."""

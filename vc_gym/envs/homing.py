@@ -26,6 +26,7 @@ __all__ = [
     "STOP_THRESHOLD",
     "HomingFeatures",
     "StopAction",
+    "goal_vector",
     "home_offset",
     "make_homing_env",
 ]
@@ -46,6 +47,20 @@ def home_offset(value: Any) -> tuple[float, float]:
             f"home_offset_m must be within {MAX_HOME_OFFSET_M} m of home, got ({x}, {y})"
         )
     return x, y
+
+
+def goal_vector(
+    home_vector: Any, heading: Any, offset_m: tuple[float, float]
+) -> tuple[float, float]:
+    """The robot-frame ``(forward, left)`` vector to the point ``offset_m`` (world frame)
+    from home, given the home vector and the heading as ``(cos θ̂, sin θ̂)`` — the
+    observation keys of :class:`~vc_gym.envs.CompassObservation`. A heading of
+    ``(0, 0)`` (no atlas yet) leaves the home vector as it is."""
+    c, s = (float(v) for v in heading)
+    ox, oy = offset_m
+    # home_vector + world_to_body(offset), written with cos/sin instead of an angle
+    fwd, left = float(home_vector[0]), float(home_vector[1])
+    return fwd + (ox * c + oy * s), left + (-ox * s + oy * c)
 
 
 class HomingFeatures(gym.ObservationWrapper):
@@ -87,9 +102,7 @@ class HomingFeatures(gym.ObservationWrapper):
         home_vector = obs["home_vector"].astype(np.float64)
         position = obs["position"].astype(np.float64)
         if self.home_offset_m != (0.0, 0.0):
-            ox, oy = self.home_offset_m
-            c, s = (float(v) for v in obs["heading"])  # (0, 0) before the atlas: no turn
-            home_vector = home_vector + (ox * c + oy * s, -ox * s + oy * c)  # world_to_body
+            home_vector = np.array(goal_vector(home_vector, obs["heading"], self.home_offset_m))
             position = position - self.home_offset_m
         f = np.concatenate(
             [

@@ -26,7 +26,7 @@ import numpy as np
 from tqdm import tqdm
 
 from vc_gym.agents.feature_expert import HomingFeatureExpert
-from vc_gym.envs.homing import MAX_HOME_OFFSET_M, HomingFeatures, StopAction, home_offset
+from vc_gym.envs.homing import MAX_HOME_OFFSET_M, home_offset
 
 __all__ = ["HomeOffset", "measure_home_offset"]
 
@@ -66,27 +66,25 @@ class HomeOffset:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready figures (metres rounded to a tenth of a millimetre)."""
 
-        def cm(v):
+        def metres(v):
             return [None if np.isnan(x) else round(float(x), 4) for x in v]
 
         return {
-            "home_offset_m": cm(self.offset_m),
+            "home_offset_m": metres(self.offset_m),
             "episodes": self.episodes,
             "stops": self.stops,
-            "spread_m": cm(self.spread_m),
+            "spread_m": metres(self.spread_m),
             "success_rate": round(self.success_rate, 4),
-            "per_place_m": [cm(v) for v in self.per_place_m],
+            "per_place_m": [metres(v) for v in self.per_place_m],
         }
 
 
-def _wrapper(env: gym.Env, cls: type) -> Any:
-    """The env's wrapper of class ``cls`` (refusing an env that is not Homing-v0)."""
-    e = env
-    while isinstance(e, gym.Wrapper):
-        if isinstance(e, cls):
-            return e
-        e = e.env
-    raise ValueError(f"measure_home_offset needs a vc_gym/Homing-v0 env (no {cls.__name__})")
+def _homing_attr(env: gym.Env, name: str) -> Any:
+    """``name`` of one of the env's wrappers (refusing an env that is not Homing-v0)."""
+    try:
+        return env.get_wrapper_attr(name)
+    except AttributeError:
+        raise ValueError(f"measure_home_offset needs a vc_gym/Homing-v0 env (no {name})") from None
 
 
 def measure_home_offset(
@@ -133,11 +131,12 @@ def measure_home_offset(
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an int >= 1, got {episodes!r}")
     for env in envs:
-        if _wrapper(env, HomingFeatures).home_offset_m != (0.0, 0.0):
+        if _homing_attr(env, "home_offset_m") != (0.0, 0.0):
             raise ValueError("measure the offset on envs whose home_offset_m is (0, 0)")
     if expert is None:
-        actions = _wrapper(envs[0], StopAction)
-        expert = HomingFeatureExpert(actions.max_forward, actions.max_turn_deg_s)
+        expert = HomingFeatureExpert(
+            _homing_attr(envs[0], "max_forward"), _homing_attr(envs[0], "max_turn_deg_s")
+        )
     per_place: list[list[np.ndarray]] = [[] for _ in envs]
     successes = 0
     with tqdm(
