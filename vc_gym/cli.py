@@ -67,6 +67,7 @@ _TRAIN_FIELDS = {
     "min_walk": "min_walk_m",
     "home_offset_episodes": "home_offset_episodes",
     "home_offset_places": "home_offset_places",
+    "home_offset_centre": "home_offset_centre",
 }
 
 
@@ -787,6 +788,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="K",
         help="places learned only for that measurement (default 3): part of the tracker's "
         "offset belongs to the place",
+    )
+    p.add_argument(
+        "--home-offset-centre",
+        action="store_true",
+        default=None,
+        help="then let the expert home again on the same kidnappings going to the measured "
+        "goal, and move the goal so that its median stop lies at the true home (a secant "
+        "step per axis; the stops can move further than the goal did)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import vc_gym  # noqa: F401
+from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.envs.homing import HomingFeatures
-from vc_gym.experiments.home_offset import MIN_STOPS, measure_home_offset
+from vc_gym.experiments.home_offset import MIN_STOPS, centre_home_offset, measure_home_offset
 from vc_gym.localization import TrackerState
 
 FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0, "stop_time_s": 0.3, "min_walk_s": 0.0}
@@ -17,10 +18,13 @@ BIAS = (0.12, -0.07)
 
 class BiasedOracle:
     """A tracker that reads the robot's true pose and reports its position off by
-    ``bias`` (a tracker whose home lies at ``-bias`` from the true one)."""
+    ``bias`` (a tracker whose home lies at ``-bias`` from the true one); with ``scale``
+    the reported position is ``bias + scale × true``, an error that changes across the
+    field (zero at ``bias / (1 - scale)``) and is ``bias`` at the true home only."""
 
-    def __init__(self, bias=BIAS):
+    def __init__(self, bias=BIAS, scale=1.0):
         self.bias = np.asarray(bias, np.float64)
+        self.scale = float(scale)
         self.room = None  # set once the env exists
 
     def reset(self, atlas, camera, dt_s):
@@ -32,7 +36,7 @@ class BiasedOracle:
         return TrackerState(
             heading_deg=float(yaw) % 360.0,
             heading_spread_deg=1.0,
-            position=(float(x + self.bias[0]), float(y + self.bias[1])),
+            position=tuple(float(v) for v in self.bias + self.scale * np.array([x, y])),
             position_std_m=(0.01, 0.01),
             goodness=np.ones(self.n_spots),
             belief=belief,
@@ -58,7 +62,7 @@ def make(place):
     envs = []
 
     def build(tracker, **kwargs):
-        env = gym.make("vc_gym/Homing-v0", tracker=lambda: tracker, **FAST, **place, **kwargs)
+        env = gym.make("vc_gym/Homing-v0", tracker=lambda: tracker, **{**FAST, **place, **kwargs})
         tracker.room = env.unwrapped.room
         envs.append(env)
         return env
@@ -97,6 +101,30 @@ def test_with_the_measured_offset_the_goal_is_the_true_home(make):
     obs, _ = plain.reset(seed=4, options={"pose": (0.0, 0.0, 130.0)})
     home = obs[HomingFeatures.HOME_VECTOR] * HomingFeatures.METRES_SCALE
     assert np.hypot(*home) == pytest.approx(np.hypot(*BIAS), abs=0.02)
+
+
+def test_the_centred_goal_puts_the_experts_stops_at_the_true_home(make):
+    """With an estimate that moves half as far as the robot, the goal read at the stops
+    is twice the error at home and the stops overshoot; the second round going to it
+    finds the slope (2) and the goal at which the stops centre on home (the bias)."""
+    env = make(BiasedOracle(scale=0.5), max_homing_s=40.0)
+    expert = HomingFeatureExpert(home_tolerance_m=0.02)  # stops within 4 cm of the goal
+    first = measure_home_offset(env, MIN_STOPS, seed=6, expert=expert)
+    np.testing.assert_allclose(first.offset_m, 2 * np.asarray(BIAS), atol=0.03)
+    centred = centre_home_offset(env, first, MIN_STOPS, seed=6, expert=expert)
+    assert centred.first_offset_m == first.offset_m and centred.centred_success_rate == 1.0
+    assert centred.episodes == 2 * MIN_STOPS
+    np.testing.assert_allclose(centred.slope, (2.0, 2.0), atol=0.4)
+    # within the expert's tolerance (it stops on the near edge of a 4 cm circle)
+    np.testing.assert_allclose(centred.offset_m, BIAS, atol=0.025)
+    # going to twice the bias it stopped twice the bias out (the estimate's home, mirrored)
+    np.testing.assert_allclose(centred.median_stop_m, 2 * np.asarray(BIAS), atol=0.03)
+    assert env.get_wrapper_attr("home_offset_m") == (0.0, 0.0)  # the env is given back
+    assert centred.to_dict()["slope"] == [round(v, 3) for v in centred.slope]
+    with pytest.raises(ValueError, match="already centred"):
+        centre_home_offset(env, centred, MIN_STOPS, seed=6)
+    with pytest.raises(ValueError, match="at least one env"):
+        centre_home_offset([], first, MIN_STOPS, seed=6)
 
 
 def test_bad_measurements_are_refused(make):

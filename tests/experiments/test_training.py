@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from vc_gym.agents.learned import LearnedHomingAgent
-from vc_gym.cli import main
+from vc_gym.cli import build_parser, main
 from vc_gym.experiments.runner import LocalBackend
 from vc_gym.experiments.studies import ExperimentOptions
 from vc_gym.experiments.studies.homing import run_homing
@@ -385,11 +385,13 @@ def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
         collector="lockstep",
         home_offset_episodes=3,
         home_offset_places=1,  # TINY keeps a checkpoint every 32 decisions
+        home_offset_centre=True,
     )
     assert config.home_offset_seeds == (0, 2_000_000)
     summary = train(config, tmp_path, progress=False)
     measured = json.loads((tmp_path / "home_offset.json").read_text())
-    assert summary["home_offset"] == measured and measured["episodes"] == 6
+    assert summary["home_offset"] == measured and measured["episodes"] == 12  # two rounds
+    assert measured["first_offset_m"] is not None and len(measured["slope"]) == 2
     assert (
         len(measured["per_place_m"]) == 2 and (tmp_path / "home-offset-place2000000.npz").is_file()
     )
@@ -420,6 +422,9 @@ def test_goal_correction_settings():
     }
     old = TrainConfig.from_dict(saved_before)
     assert old.home_offset_episodes == 0 and old.home_offset_m is None
+    assert old.home_offset_centre is False and TrainConfig().home_offset_centre is False
+    centred = replace(TINY, home_offset_centre=True)
+    assert TrainConfig.from_dict(json.loads(json.dumps(centred.to_dict()))) == centred
     for bad in (
         {"home_offset_episodes": -1},
         {"home_offset_places": 17},
@@ -428,6 +433,13 @@ def test_goal_correction_settings():
         {"home_offset_m": (float("nan"), 0.0)},
         {"home_offset_m": (0.1,)},
         {"home_offset_m": "0.1,0.2"},
+        {"home_offset_centre": "yes"},
+        {"home_offset_centre": 1},
     ):
         with pytest.raises(ValueError, match="home_offset"):
             TrainConfig(**bad)
+
+
+def test_the_command_line_asks_for_a_centred_goal():
+    assert build_parser().parse_args(["train", "--home-offset-centre"]).home_offset_centre
+    assert build_parser().parse_args(["train"]).home_offset_centre is None  # the config's

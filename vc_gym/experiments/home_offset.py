@@ -7,18 +7,26 @@ the paper*: the robot stood at (+11, −12), (+12, −14) and (+14, −13) cm on
 agent that stops where the tracker says home inherits it. A learned agent can do better
 because training, unlike homing, knows the true pose: before the warm start,
 :func:`measure_home_offset` lets the scripted expert home a few times in each of several
-places and takes, per axis, the median of ``estimate − true position`` at its stops.
-``vc-gym train`` then trains and evaluates on ``vc_gym/Homing-v0(home_offset_m=that)``:
-the policy's home vector points where the estimate reads when the robot stands at the
-true home. Part of the offset belongs to the place (in training seed 0's four places the
-medians ranged from −14.9 to −2.6 cm in x and from +5.0 to +17.4 cm in y), so the
-measurement pools several places.
+places and takes, per axis, the median of ``estimate − true position`` where it stands
+at the end. ``vc-gym train`` then trains and evaluates on
+``vc_gym/Homing-v0(home_offset_m=that)``: the policy's home vector points where the
+estimate reads when the robot stands at the true home. Part of the offset belongs to the
+place (in training seed 0's four places the medians ranged from −14.9 to −2.6 cm in x and
+from +5.0 to +17.4 cm in y), so the measurement pools several places.
+
+The error read at the stops is not quite the goal: the stops lie around the tracker's
+home, 10–20 cm from the true one, where the error differs, and going to the corrected
+goal the stops can move further than the goal did (in training seed 1's places 1.2–1.5
+times as far, overshooting to the north-west). :func:`centre_home_offset` (``vc-gym
+train --home-offset-centre``) then lets the expert home again on the same kidnappings,
+going to the measured goal, and moves the goal so that its median stop lies at the true
+home (a secant step per axis).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import gymnasium as gym
@@ -27,11 +35,15 @@ from tqdm import tqdm
 
 from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.envs.homing import MAX_HOME_OFFSET_M, home_offset
+from vc_gym.envs.learning import HOME
 
-__all__ = ["HomeOffset", "measure_home_offset"]
+__all__ = ["HomeOffset", "centre_home_offset", "measure_home_offset"]
 
 #: Fewest expert stops a measured offset may rest on.
 MIN_STOPS = 5
+#: Bounds of how far the expert's median stop moves per metre of goal
+#: (:func:`centre_home_offset`).
+MIN_SLOPE, MAX_SLOPE = 0.5, 3.0
 
 
 @dataclass(frozen=True)
@@ -54,6 +66,18 @@ class HomeOffset:
         going to the tracker's home, before the correction).
     per_place_m : tuple of (float, float)
         The median of each place's own stops (``nan`` for a place without stops).
+    median_stop_m : (float, float)
+        The median true position of the expert's stops, from home (m); after
+        :func:`centre_home_offset`, of its stops going to ``first_offset_m``.
+    first_offset_m : (float, float) or None
+        With :func:`centre_home_offset`: the goal before the correction (``None``
+        without).
+    slope : (float, float) or None
+        With :func:`centre_home_offset`: per axis, how far the median stop moved per
+        metre of goal.
+    centred_success_rate : float or None
+        With :func:`centre_home_offset`: the expert's success going to
+        ``first_offset_m``.
     """
 
     offset_m: tuple[float, float]
@@ -62,6 +86,10 @@ class HomeOffset:
     spread_m: tuple[float, float]
     success_rate: float
     per_place_m: tuple[tuple[float, float], ...]
+    median_stop_m: tuple[float, float] = (float("nan"), float("nan"))
+    first_offset_m: tuple[float, float] | None = None
+    slope: tuple[float, float] | None = None
+    centred_success_rate: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready figures (metres rounded to a tenth of a millimetre)."""
@@ -76,6 +104,12 @@ class HomeOffset:
             "spread_m": metres(self.spread_m),
             "success_rate": round(self.success_rate, 4),
             "per_place_m": [metres(v) for v in self.per_place_m],
+            "median_stop_m": metres(self.median_stop_m),
+            "first_offset_m": None if self.first_offset_m is None else metres(self.first_offset_m),
+            "slope": None if self.slope is None else [round(v, 3) for v in self.slope],
+            "centred_success_rate": None
+            if self.centred_success_rate is None
+            else round(self.centred_success_rate, 4),
         }
 
 
@@ -134,26 +168,11 @@ def measure_home_offset(
         if _homing_attr(env, "home_offset_m") != (0.0, 0.0):
             raise ValueError("measure the offset on envs whose home_offset_m is (0, 0)")
     if expert is None:
-        expert = HomingFeatureExpert(
-            _homing_attr(envs[0], "max_forward"), _homing_attr(envs[0], "max_turn_deg_s")
-        )
-    per_place: list[list[np.ndarray]] = [[] for _ in envs]
-    successes = 0
+        expert = _default_expert(envs[0])
     with tqdm(
         total=episodes * len(envs), desc="home offset", unit="ep", disable=not progress
     ) as bar:
-        for j, env in enumerate(envs):
-            for k in range(episodes):
-                obs, _ = env.reset(seed=int(seed) + j if k == 0 else None)
-                done, info = False, {}
-                while not done:
-                    obs, _, terminated, truncated, info = env.step(expert.predict(obs))
-                    done = terminated or truncated
-                successes += bool(info.get("success", False))
-                estimate = info.get("estimate")
-                if info.get("stopped") and estimate is not None:
-                    per_place[j].append(np.subtract(estimate["position"], info["stop_position"]))
-                bar.update(1)
+        per_place, stops, successes = _homing_round(envs, episodes, seed, expert, bar)
     samples = [e for place in per_place for e in place]
     total = episodes * len(envs)
     if len(samples) < MIN_STOPS:
@@ -180,4 +199,110 @@ def measure_home_offset(
         spread_m=(float(spread[0]), float(spread[1])),
         success_rate=successes / total,
         per_place_m=places,  # type: ignore[arg-type]
+        median_stop_m=tuple(float(v) for v in np.median(stops, axis=0)),  # type: ignore[arg-type]
+    )
+
+
+def _default_expert(env: gym.Env) -> HomingFeatureExpert:
+    """The scripted rule at the env's walking speed and turn rate."""
+    return HomingFeatureExpert(
+        _homing_attr(env, "max_forward"), _homing_attr(env, "max_turn_deg_s")
+    )
+
+
+def _homing_round(
+    envs: list[gym.Env], episodes: int, seed: int, expert: Any, bar: tqdm
+) -> tuple[list[list[np.ndarray]], list[np.ndarray], int]:
+    """``episodes`` kidnappings in each env: per place the ``estimate − true`` of each
+    stop, the true positions of all stops, and how many episodes succeeded."""
+    per_place: list[list[np.ndarray]] = [[] for _ in envs]
+    stops: list[np.ndarray] = []
+    successes = 0
+    for j, env in enumerate(envs):
+        for k in range(episodes):
+            obs, _ = env.reset(seed=int(seed) + j if k == 0 else None)
+            done = False
+            while not done:
+                obs, _, terminated, truncated, info = env.step(expert.predict(obs))
+                done = terminated or truncated
+            successes += bool(info.get("success", False))
+            estimate = info.get("estimate")
+            if info.get("stopped") and estimate is not None:
+                per_place[j].append(np.subtract(estimate["position"], info["stop_position"]))
+                stops.append(np.asarray(info["stop_position"], np.float64) - HOME)
+            bar.update(1)
+    return per_place, stops, successes
+
+
+def centre_home_offset(
+    envs: gym.Env | Sequence[gym.Env],
+    first: HomeOffset,
+    episodes: int,
+    seed: int,
+    expert: Any = None,
+    progress: bool = False,
+) -> HomeOffset:
+    """Correct a measured goal so that the expert's stops centre on the true home.
+
+    ``first`` (:func:`measure_home_offset`) moves the goal by the error read where the
+    expert stopped, but going there the stops can move further than the goal (1.2–1.5
+    times in training seed 1's places, once in seed 0's: the expert stops where its
+    noisy walking estimate first comes within its tolerance, and the estimate does not
+    move one for one with the robot everywhere). So the expert homes again on the same
+    kidnappings, going to ``first``'s goal, and per axis the goal at which the median
+    stop would lie at home is found on the line through the two rounds (a secant step,
+    the slope clipped to [:data:`MIN_SLOPE`, :data:`MAX_SLOPE`]).
+
+    Parameters
+    ----------
+    envs, episodes, seed, expert, progress
+        As given to :func:`measure_home_offset` for ``first`` (the envs' goal is set to
+        ``first.offset_m`` for the round and back to ``(0, 0)`` after it).
+    first : HomeOffset
+        The measurement to correct (of :func:`measure_home_offset`).
+
+    Raises
+    ------
+    ValueError
+        For a ``first`` that is already centred, fewer than :data:`MIN_STOPS` stops
+        going to its goal, or a corrected goal beyond
+        :data:`~vc_gym.envs.homing.MAX_HOME_OFFSET_M`.
+    """
+    envs = [envs] if isinstance(envs, gym.Env) else list(envs)
+    if first.first_offset_m is not None:
+        raise ValueError("this goal is already centred (centre_home_offset was applied)")
+    if not envs:
+        raise ValueError("centre_home_offset needs at least one env")
+    if expert is None:
+        expert = _default_expert(envs[0])
+    goal = np.asarray(first.offset_m, np.float64)
+    try:
+        for env in envs:
+            env.set_wrapper_attr("home_offset_m", home_offset(first.offset_m))
+        with tqdm(
+            total=episodes * len(envs), desc="home offset, 2nd", unit="ep", disable=not progress
+        ) as bar:
+            _, stops, successes = _homing_round(envs, episodes, seed, expert, bar)
+    finally:
+        for env in envs:
+            env.set_wrapper_attr("home_offset_m", (0.0, 0.0))
+    if len(stops) < MIN_STOPS:
+        raise ValueError(
+            f"going to the measured goal the expert stopped in only {len(stops)} of "
+            f"{episodes * len(envs)} episodes; the correction needs at least {MIN_STOPS}"
+        )
+    before = np.asarray(first.median_stop_m, np.float64)
+    after = np.median(np.asarray(stops, np.float64), axis=0)
+    # how far the median stop moved per metre of goal, per axis (1 where the goal is ~0)
+    moved = np.where(np.abs(goal) > 0.01, (after - before) / np.where(goal == 0, 1, goal), 1.0)
+    slope = np.clip(moved, MIN_SLOPE, MAX_SLOPE)
+    centred = goal - after / slope
+    return replace(
+        first,
+        offset_m=home_offset(tuple(round(float(v), 4) for v in centred)),
+        episodes=first.episodes + episodes * len(envs),
+        median_stop_m=tuple(float(v) for v in after),  # type: ignore[arg-type]
+        first_offset_m=first.offset_m,
+        slope=tuple(float(v) for v in slope),  # type: ignore[arg-type]
+        centred_success_rate=successes / (episodes * len(envs)),
     )

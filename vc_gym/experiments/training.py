@@ -28,7 +28,7 @@ from vc_gym.envs.homing import home_offset
 from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.episode import LEARNED_CONFIRM_STOP_M
-from vc_gym.experiments.home_offset import MIN_STOPS, measure_home_offset
+from vc_gym.experiments.home_offset import MIN_STOPS, centre_home_offset, measure_home_offset
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import make_tracker
@@ -115,6 +115,13 @@ class TrainConfig:
         Places learned only for that measurement (learning seeds
         ``HOME_OFFSET_SEED + 16 × seed + k``, ``DIR/home-offset-place<s>.npz``): part of
         the offset belongs to the place. Default 3.
+    home_offset_centre : bool
+        Then correct the measured goal so that the expert's median stop lies at the true
+        home: the expert homes again on the same kidnappings going to it, and a secant
+        step per axis moves the goal
+        (:func:`~vc_gym.experiments.home_offset.centre_home_offset`; twice the expert
+        episodes). Default ``False``. A ``config.json`` saved before the field existed
+        was not centred.
     home_offset_m : (float, float), optional
         The goal correction itself (metres, world frame). ``None`` (default): measured
         with ``home_offset_episodes``, or ``(0, 0)`` without; a run's ``config.json``
@@ -179,6 +186,7 @@ class TrainConfig:
     min_walk_m: float = 0.0
     home_offset_episodes: int = DEFAULT_HOME_OFFSET_EPISODES
     home_offset_places: int = 3
+    home_offset_centre: bool = False
     home_offset_m: tuple[float, float] | None = None
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
@@ -242,6 +250,10 @@ class TrainConfig:
         if self.home_offset_places > MAX_PLACES:
             raise ValueError(
                 f"home_offset_places must be at most {MAX_PLACES}, got {self.home_offset_places}"
+            )
+        if not isinstance(self.home_offset_centre, (bool, np.bool_)):
+            raise ValueError(
+                f"home_offset_centre must be True or False, got {self.home_offset_centre!r}"
             )
         if self.home_offset_m is not None:
             object.__setattr__(self, "home_offset_m", home_offset(self.home_offset_m))
@@ -343,6 +355,7 @@ class TrainConfig:
         data.setdefault("min_walk_m", 0.0)
         data.setdefault("home_offset_episodes", 0)
         data.setdefault("home_offset_places", 0)
+        data.setdefault("home_offset_centre", False)
         data.setdefault("collector", "lockstep")
         config = cls.from_settings(data)
         if env is not None and env != config.env_kwargs():
@@ -661,12 +674,12 @@ def _measure_goal(
     try:
         for s in config.home_offset_seeds:
             envs.append(_place_env(config, s, files.get(s, out / f"home-offset-place{s}.npz")))
-        measured = measure_home_offset(
-            envs,
-            config.home_offset_episodes,
-            HOME_OFFSET_SEED + MAX_PLACES * config.seed,
-            progress=progress,
-        )
+        seed = HOME_OFFSET_SEED + MAX_PLACES * config.seed
+        measured = measure_home_offset(envs, config.home_offset_episodes, seed, progress=progress)
+        if config.home_offset_centre:
+            measured = centre_home_offset(
+                envs, measured, config.home_offset_episodes, seed, progress=progress
+            )
     finally:
         for env in envs:
             env.close()
