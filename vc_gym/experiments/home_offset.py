@@ -1,4 +1,4 @@
-"""Where the tracker's estimate really puts home: the goal a learned agent is trained for.
+"""The tracker's error where the expert stops: the goal a learned agent is trained for.
 
 In the paper's procedure the spots are normalised where the robot believes home is after
 walking back by odometry, a few centimetres off the true home, so the tracker's home lies
@@ -9,14 +9,16 @@ because training, unlike homing, knows the true pose: before the warm start,
 :func:`measure_home_offset` lets the scripted expert home a few times in each of several
 places and takes, per axis, the median of ``estimate − true position`` where it stands
 at the end. ``vc-gym train`` then trains and evaluates on
-``vc_gym/Homing-v0(home_offset_m=that)``: the policy's home vector points where the
-estimate reads when the robot stands at the true home. Part of the offset belongs to the
+``vc_gym/Homing-v0(home_offset_m=that)``: the policy's home vector points to where the
+estimate read at the expert's stops would put the true home. Part of the offset belongs to the
 place (in training seed 0's four places the medians ranged from −14.9 to −2.6 cm in x and
 from +5.0 to +17.4 cm in y), so the measurement pools several places.
 
-The error read at the stops is not quite the goal: the stops lie around the tracker's
-home, 10–20 cm from the true one, where the error differs, and going to the corrected
-goal the stops can move further than the goal did (in training seed 1's places 1.2–1.5
+It is not the estimate read at the true home itself: the agent decides to stop on its
+walking estimate, which is noisy (at the true home, ±30 cm), and the estimate after a
+stand there differs again (in training seed 0's places (−16, +16) cm after 5 s, against
+(−7, +10) cm at the stops). What matters is where the stops end up, and going to the
+corrected goal the stops can move further than the goal did (in training seed 1's places 1.2–1.5
 times as far, overshooting to the north-west). :func:`centre_home_offset` (``vc-gym
 train --home-offset-centre``) then lets the expert home again on the same kidnappings,
 going to the measured goal, and moves the goal so that its median stop lies at the true

@@ -107,10 +107,10 @@ class TrainConfig:
         training place(s) and ``home_offset_places`` more, and the median ``estimate −
         true position`` at its stops becomes the goal of the agent's env
         (``home_offset_m`` of ``vc_gym/Homing-v0``; :mod:`vc_gym.experiments.home_offset`;
-        ``DIR/home_offset.json``): the policy learns to stop where the tracker's
-        estimate reads when the robot stands at the true home, not where the tracker
-        believes home is (README, *Learned agents*). Default 10; 0: the atlas' home. A
-        ``config.json`` saved before the field existed was trained with 0.
+        ``DIR/home_offset.json``): the policy learns to stop where that error says the
+        true home is, not where the tracker believes home is (README, *Learned
+        agents*). Default 10; 0: the atlas' home. A ``config.json`` saved before the
+        field existed was trained with 0.
     home_offset_places : int
         Places learned only for that measurement (learning seeds
         ``HOME_OFFSET_SEED + 16 × seed + k``, ``DIR/home-offset-place<s>.npz``): part of
