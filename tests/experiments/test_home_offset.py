@@ -125,6 +125,11 @@ def test_the_centred_goal_puts_the_experts_stops_at_the_true_home(make):
         centre_home_offset(env, centred, MIN_STOPS, seed=6)
     with pytest.raises(ValueError, match="at least one env"):
         centre_home_offset([], first, MIN_STOPS, seed=6)
+    for bad in (0, 2.5, True):  # the same checks as the measurement's
+        with pytest.raises(ValueError, match="episodes"):
+            centre_home_offset(env, first, bad, seed=6)
+    with pytest.raises(ValueError, match="Homing-v0"):
+        centre_home_offset(gym.make("CartPole-v1"), first, MIN_STOPS, seed=6, expert=expert)
 
 
 def test_bad_measurements_are_refused(make):

@@ -161,14 +161,7 @@ def measure_home_offset(
         fewer than :data:`MIN_STOPS` stops, or an offset beyond
         :data:`~vc_gym.envs.homing.MAX_HOME_OFFSET_M` (the tracker is lost, not off).
     """
-    envs = [envs] if isinstance(envs, gym.Env) else list(envs)
-    if not envs:
-        raise ValueError("measure_home_offset needs at least one env")
-    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
-        raise ValueError(f"episodes must be an int >= 1, got {episodes!r}")
-    for env in envs:
-        if _homing_attr(env, "home_offset_m") != (0.0, 0.0):
-            raise ValueError("measure the offset on envs whose home_offset_m is (0, 0)")
+    envs = _checked_envs(envs, episodes, "measure_home_offset")
     if expert is None:
         expert = _default_expert(envs[0])
     with tqdm(
@@ -203,6 +196,20 @@ def measure_home_offset(
         per_place_m=places,  # type: ignore[arg-type]
         median_stop_m=tuple(float(v) for v in np.median(stops, axis=0)),  # type: ignore[arg-type]
     )
+
+
+def _checked_envs(envs: gym.Env | Sequence[gym.Env], episodes: int, caller: str) -> list[gym.Env]:
+    """``envs`` as a list, refused unless each is a Homing-v0 going to the atlas' home
+    and ``episodes`` is an int >= 1."""
+    envs = [envs] if isinstance(envs, gym.Env) else list(envs)
+    if not envs:
+        raise ValueError(f"{caller} needs at least one env")
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ValueError(f"episodes must be an int >= 1, got {episodes!r}")
+    for env in envs:
+        if _homing_attr(env, "home_offset_m") != (0.0, 0.0):
+            raise ValueError("measure the offset on envs whose home_offset_m is (0, 0)")
+    return envs
 
 
 def _default_expert(env: gym.Env) -> HomingFeatureExpert:
@@ -266,15 +273,14 @@ def centre_home_offset(
     Raises
     ------
     ValueError
-        For a ``first`` that is already centred, fewer than :data:`MIN_STOPS` stops
-        going to its goal, or a corrected goal beyond
+        For a ``first`` that is already centred, the env and episode errors of
+        :func:`measure_home_offset`, fewer than :data:`MIN_STOPS` stops going to its
+        goal, or a corrected goal beyond
         :data:`~vc_gym.envs.homing.MAX_HOME_OFFSET_M`.
     """
-    envs = [envs] if isinstance(envs, gym.Env) else list(envs)
     if first.first_offset_m is not None:
         raise ValueError("this goal is already centred (centre_home_offset was applied)")
-    if not envs:
-        raise ValueError("centre_home_offset needs at least one env")
+    envs = _checked_envs(envs, episodes, "centre_home_offset")
     if expert is None:
         expert = _default_expert(envs[0])
     goal = np.asarray(first.offset_m, np.float64)
