@@ -89,6 +89,59 @@ def test_resume_after_a_killed_run_redoes_nothing_and_loses_nothing(tmp_path):
     assert len(log.read_text().split()) - len(before) == 8 - len(finished)
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    # a zombie (exited, not yet reaped by its new parent) counts as gone
+    stat = Path(f"/proc/{pid}/stat")
+    return not (stat.is_file() and stat.read_text().rsplit(")", 1)[1].split()[0] == "Z")
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads /proc")
+def test_workers_of_a_killed_parent_stop_their_jobs(tmp_path):
+    log = tmp_path / "pids.txt"
+    script = (
+        f"import sys; sys.path.insert(0, {str(HERE)!r}); from test_runner import run_squares; "
+        f"run_squares({str(tmp_path / 'run')!r}, 2, n=2, log={str(log)!r}, sleep_s=120)"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", script])
+    try:
+        deadline = time.monotonic() + 60  # the pool is up once both workers are busy
+        while time.monotonic() < deadline and not _worker_pids(proc.pid):
+            time.sleep(0.1)
+        workers = _worker_pids(proc.pid)
+        assert len(workers) == 2, "the pool did not start"
+        time.sleep(2.0)  # both workers are now in their 120 s jobs
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and any(map(_alive, workers)):
+        time.sleep(0.2)
+    left = [pid for pid in workers if _alive(pid)]
+    for pid in left:  # do not leave them running if the test fails
+        os.kill(pid, signal.SIGKILL)
+    assert not left, "the workers outlived their parent"
+    assert not log.exists()  # no job ran to its end
+
+
+def _worker_pids(parent: int) -> list[int]:
+    """The pool workers among ``parent``'s children (not its resource tracker)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            text = stat.read_text()
+            cmdline = (stat.parent / "cmdline").read_bytes()
+        except OSError:
+            continue
+        ppid = int(text.rsplit(")", 1)[1].split()[1])
+        if ppid == parent and b"spawn_main" in cmdline:
+            found.append(int(stat.parent.name))
+    return found
+
+
 def test_a_failing_job_is_retried_once_then_reported(tmp_path):
     run = ExperimentRun(tmp_path, "toy", LocalBackend(1), {}, progress=False)
     jobs = [

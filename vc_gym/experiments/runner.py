@@ -29,6 +29,7 @@ import math
 import multiprocessing as mp
 import os
 import platform
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -168,8 +169,12 @@ def worker_cache(key: Any, make: Callable[[], Any], limit: int = 4) -> Any:
     return value
 
 
-def _init_worker(quiet: bool = False) -> None:
+def _init_worker(quiet: bool = False, parent_pid: int | None = None) -> None:
     os.environ.update(SINGLE_THREADED)
+    if parent_pid is not None:
+        threading.Thread(
+            target=_exit_with_parent, args=(parent_pid,), name="parent-watch", daemon=True
+        ).start()
     if quiet:
         # native libraries print to the process' stdout (PyBullet: "argv[0]=", its build
         # time) and would scribble over the parent's progress bar; jobs return data
@@ -184,12 +189,25 @@ def _init_worker(quiet: bool = False) -> None:
         pass
 
 
+def _exit_with_parent(parent_pid: int, period_s: float = 1.0) -> None:
+    """End this pool worker once the process that started it is gone.
+
+    A parent killed outright (SIGKILL, the OOM killer) cannot shut its pool down, and
+    its workers would run their jobs to the end, holding the cores, with no one to
+    report to. An orphan is re-parented, so its parent id changes.
+    """
+    while os.getppid() == parent_pid:
+        time.sleep(period_s)
+    os._exit(1)
+
+
 # --------------------------------------------------------------------------- backends
 class LocalBackend:
     """Jobs in a pool of ``workers`` processes on this machine (1: in this process).
 
     A worker that dies (killed by the OOM killer, a crash in native code) fails the
     jobs it was running, which are then retried on a fresh pool; it never hangs the run.
+    Workers whose parent dies exit within a second or so instead of running on.
     """
 
     name = "local"
@@ -226,7 +244,7 @@ class LocalBackend:
                     self.workers,
                     mp_context=mp.get_context("spawn"),
                     initializer=_init_worker,
-                    initargs=(True,),
+                    initargs=(True, os.getpid()),
                 )
                 # start the workers now, while the environment is single-threaded
                 list(self._executor.map(_noop, range(self.workers)))
