@@ -779,8 +779,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="before the warm start the scripted expert homes N times in each training "
         "place and --home-offset-places more; the median of (tracker's position - true "
         "position) at its stops becomes the policy's goal, so that it stops at the true "
-        "home, not where the tracker puts home (DIR/home_offset.json; default 10; 0: the "
-        "tracker's home)",
+        "home, not where the tracker puts home (DIR/home_offset.json; default 0: the "
+        "tracker's home; README, Learned agents, compares 10)",
     )
     p.add_argument(
         "--home-offset-places",
@@ -795,7 +795,8 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="then let the expert home again on the same kidnappings going to the measured "
         "goal, and move the goal so that its median stop lies at the true home (a secant "
-        "step per axis; the stops can move further than the goal did)",
+        "step per axis; the stops can move further than the goal did; needs "
+        "--home-offset-episodes)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

@@ -78,3 +78,12 @@ def test_env_arguments_the_env_refuses_name_the_config_file(tmp_path, capsys, ch
     argv = ["evaluate", "--agent", str(tmp_path / "agent" / "model.zip"), "--out", str(out)]
     assert main(argv) == 2
     assert str(cfg) in capsys.readouterr().err and not out.exists()
+
+
+def test_shipped_policy_was_trained_with_the_default_settings():
+    # README: the shipped policy is seed 0 of `vc-gym train --seeds 0,1,2 --workers 1`;
+    # a change of TrainConfig's defaults must re-ship it (or say why not)
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+    from vc_gym.experiments.training import TrainConfig, read_train_config
+
+    assert read_train_config(PRETRAINED_MODEL.parent / "config.json") == TrainConfig(seed=0)

@@ -74,9 +74,9 @@ class HomingFeatures(gym.ObservationWrapper):
     ``home_offset_m`` moves the goal the vector describes from the atlas' home to that
     point (world frame, metres from it): the home vector points there and the position
     is measured from there. A learned agent trained with it walks to, and stops at,
-    that point of its tracker's estimate, which ``vc-gym train`` measures so that the
-    expert's stops centre on the true home (:mod:`vc_gym.experiments.home_offset`).
-    Default ``(0, 0)``.
+    that point of its tracker's estimate, which ``vc-gym train --home-offset-episodes N``
+    can measure so that the expert's stops centre on the true home
+    (:mod:`vc_gym.experiments.home_offset`). Default ``(0, 0)``.
     """
 
     HOME_VECTOR = slice(0, 2)
