@@ -101,7 +101,7 @@ def _alive(pid: int) -> bool:
 
 @pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads /proc")
 def test_workers_of_a_killed_parent_stop_their_jobs(tmp_path):
-    log = tmp_path / "pids.txt"
+    log = tmp_path / "done.txt"  # a job that ends writes here
     script = (
         f"import sys; sys.path.insert(0, {str(HERE)!r}); from test_runner import run_squares; "
         f"run_squares({str(tmp_path / 'run')!r}, 2, n=2, log={str(log)!r}, sleep_s=120)"
