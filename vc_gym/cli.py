@@ -65,6 +65,7 @@ _TRAIN_FIELDS = {
     "collector": "collector",
     "closeness_bonus": "closeness_bonus",
     "min_walk": "min_walk_m",
+    "previous_action": "previous_action",
     "home_offset_episodes": "home_offset_episodes",
     "home_offset_places": "home_offset_places",
     "home_offset_centre": "home_offset_centre",
@@ -771,6 +772,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="M",
         help="stop requests are ignored until the robot has walked M metres by its own "
         "forward commands (default 0)",
+    )
+    p.add_argument(
+        "--previous-action",
+        action="store_true",
+        default=None,
+        help="the policy also sees its last action, and the expert it is warm-started from "
+        "keeps a turn going while home is behind it (against turning on the spot with "
+        "home behind; default off)",
     )
     p.add_argument(
         "--home-offset-episodes",

@@ -61,3 +61,33 @@ def test_bad_features_are_rejected(bad):
 def test_bad_settings_are_rejected(kwargs):
     with pytest.raises(ValueError):
         HomingFeatureExpert(**kwargs)
+
+
+def with_previous(f: np.ndarray, walk: float, turn: float, stop: float = -1.0) -> np.ndarray:
+    return np.concatenate([f, np.array([walk, turn, stop], np.float32)])
+
+
+@pytest.mark.parametrize("last_turn", [1.0, -1.0])
+def test_with_its_last_action_it_keeps_turning_while_home_is_behind(last_turn):
+    expert = HomingFeatureExpert(previous_action=True)
+    # home 1 m behind, a little to the left: the bearing's sign says turn left (+)
+    behind_left = features(-1.0, 0.05)
+    assert HomingFeatureExpert().predict(behind_left)[1] == pytest.approx(1.0)
+    _, turn, stop = expert.predict(with_previous(behind_left, -1.0, last_turn))
+    assert turn == pytest.approx(last_turn) and stop < STOP_THRESHOLD
+    # not turning before (e.g. after a reset or while settling): the bearing decides
+    assert expert.predict(with_previous(behind_left, -1.0, 0.0))[1] == pytest.approx(1.0)
+    # once home is no longer behind, the bearing decides again
+    ahead_right = features(1.0, -0.5)
+    assert expert.predict(with_previous(ahead_right, -1.0, 1.0))[1] < 0
+
+
+def test_with_its_last_action_the_rest_is_unchanged():
+    plain, with_last = HomingFeatureExpert(), HomingFeatureExpert(previous_action=True)
+    for fwd, left, spread in [(1.0, 0.0, 5.0), (0.05, 0.0, 5.0), (1.0, 0.3, 60.0), (0.2, 1.0, 5)]:
+        f = features(fwd, left, spread)
+        np.testing.assert_array_equal(
+            plain.predict(f), with_last.predict(with_previous(f, 0.3, 0.8))
+        )
+    with pytest.raises(ValueError, match="previous_action"):
+        HomingFeatureExpert(previous_action="yes")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -201,3 +203,37 @@ def test_home_offset_moves_the_goal_of_the_features():
 def test_home_offset_must_be_a_nearby_point(bad):
     with pytest.raises(ValueError, match="home_offset_m"):
         gym.make("vc_gym/Homing-v0", home_offset_m=bad, **FAST)
+
+
+def test_previous_action_appends_the_last_action_taken():
+    from gymnasium.utils.env_checker import check_env
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    from vc_gym.envs import PreviousAction
+
+    env = gym.make("vc_gym/Homing-v0", previous_action=True, **FAST)
+    assert env.observation_space.shape == (15,)
+    obs, _ = env.reset(seed=0)
+    assert env.observation_space.contains(obs)
+    np.testing.assert_array_equal(obs[PreviousAction.PREVIOUS_ACTION], np.zeros(3))
+    plain = gym.make("vc_gym/Homing-v0", **FAST)  # the rest of the vector is its own
+    np.testing.assert_array_equal(plain.reset(seed=0)[0], obs[:-3])
+    obs, *_ = env.step(np.array([0.3, 2.0, -0.2]))  # the turn is clipped to 1
+    np.testing.assert_allclose(obs[PreviousAction.PREVIOUS_ACTION], [0.3, 1.0, -0.2], atol=1e-6)
+    assert env.observation_space.contains(obs)
+    obs, _ = env.reset(seed=1)
+    np.testing.assert_array_equal(obs[PreviousAction.PREVIOUS_ACTION], np.zeros(3))
+    checked = gym.make("vc_gym/Homing-v0", previous_action=True, **FAST)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        check_env(checked, skip_render_check=True)  # as the agent sees it
+        sb3_check_env(checked, warn=True)
+    checked.close()
+    problems = [str(w.message) for w in record if "unwrapped version" not in str(w.message)]
+    assert not problems, problems
+    for e in (env, plain):
+        e.close()
+    with pytest.raises(ValueError, match="previous_action"):
+        gym.make("vc_gym/Homing-v0", previous_action="yes", **FAST)
+    with pytest.raises(ValueError, match="feature vector"):
+        PreviousAction(gym.make("vc_gym/LearnThenHome-v0", **FAST))

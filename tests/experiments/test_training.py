@@ -446,3 +446,33 @@ def test_goal_correction_settings():
 def test_the_command_line_asks_for_a_centred_goal():
     assert build_parser().parse_args(["train", "--home-offset-centre"]).home_offset_centre
     assert build_parser().parse_args(["train"]).home_offset_centre is None  # the config's
+
+
+def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
+    config = replace(
+        TINY,
+        previous_action=True,
+        timesteps=32,
+        eval_freq=0,
+        save_freq=0,
+        vec_env="dummy",
+        collector="lockstep",
+        demo_episodes=1,  # the expert reads its last action too
+        max_homing_s=20.0,
+    )
+    assert config.env_kwargs()["previous_action"] is True
+    assert "previous_action" not in TINY.env_kwargs()
+    assert TrainConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
+    summary = train(config, tmp_path, progress=False)
+    assert summary["warm_start"]["demo_episodes"] == 1
+    agent = LearnedHomingAgent(tmp_path / "model.zip")
+    env = agent.make_env()
+    assert env.observation_space.shape == (15,)
+    obs, _ = env.reset(seed=3)
+    assert agent.predict(obs).shape == (3,)
+    env.close()
+    # a config.json saved before the field existed: trained without it
+    saved_before = {k: v for k, v in TINY.to_dict().items() if k != "previous_action"}
+    assert TrainConfig.from_dict(saved_before).previous_action is False
+    with pytest.raises(ValueError, match="previous_action"):
+        TrainConfig(previous_action="yes")

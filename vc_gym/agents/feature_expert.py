@@ -5,7 +5,9 @@ behaviour (5.2) re-expressed for the env a learned agent sees: it reads the
 :class:`~vc_gym.envs.HomingFeatures` vector and answers with
 :class:`~vc_gym.envs.StopAction`'s ``(walk, turn, stop)``. Its decisions are the
 demonstrations a learned agent is warm-started from (behaviour cloning, ``vc-gym train
---demo-episodes``). It keeps no memory, like the MLP policy that clones it.
+--demo-episodes``). It keeps no memory, like the MLP policy that clones it; with
+``previous_action=True`` it reads its last action from the vector
+(:class:`~vc_gym.envs.PreviousAction`) and keeps a turn going while home is behind.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ import math
 
 import numpy as np
 
-from vc_gym.envs.homing import HomingFeatures
+from vc_gym.envs.homing import HomingFeatures, PreviousAction
 from vc_gym.validation import positive_float
 
 __all__ = ["HomingFeatureExpert"]
@@ -38,7 +40,15 @@ class HomingFeatureExpert:
         Stop when the estimated home is this close.
     max_spread_deg : float
         Do not walk while the heading spread is wider than this.
+    previous_action : bool
+        The vectors end with the last action (``vc_gym/Homing-v0(previous_action=True)``):
+        while the estimated home lies more than ``BEHIND_DEG`` off the heading, a turn of
+        at least half the full rate goes on at the full rate in the same direction,
+        instead of following the bearing's sign, which flips as the bearing crosses 180°.
     """
+
+    #: Bearing (deg) beyond which home counts as behind (``previous_action``).
+    BEHIND_DEG = 90.0
 
     def __init__(
         self,
@@ -46,11 +56,15 @@ class HomingFeatureExpert:
         max_turn_deg_s: float = 60.0,
         home_tolerance_m: float = 0.1,
         max_spread_deg: float = 30.0,
+        previous_action: bool = False,
     ):
         self.max_forward = positive_float("max_forward", max_forward)
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
         self.home_tolerance_m = positive_float("home_tolerance_m", home_tolerance_m)
         self.max_spread_deg = positive_float("max_spread_deg", max_spread_deg)
+        if not isinstance(previous_action, (bool, np.bool_)):
+            raise ValueError(f"previous_action must be True or False, got {previous_action!r}")
+        self.previous_action = bool(previous_action)
 
     def predict(self, features: np.ndarray) -> np.ndarray:
         """``(walk, turn, stop)`` in ``[-1, 1]`` for one feature vector, or one row each
@@ -58,7 +72,8 @@ class HomingFeatureExpert:
         f = np.asarray(features, dtype=np.float64)
         if f.ndim == 2:
             return np.stack([self.predict(row) for row in f]).astype(np.float32)
-        if f.ndim != 1 or f.shape[0] <= HomingFeatures.GOODNESS_START or not np.all(np.isfinite(f)):
+        shortest = HomingFeatures.GOODNESS_START + (3 if self.previous_action else 0)
+        if f.ndim != 1 or f.shape[0] <= shortest or not np.all(np.isfinite(f)):
             raise ValueError(f"expected one finite Homing-v0 feature vector, got shape {f.shape}")
         fwd, left = f[HomingFeatures.HOME_VECTOR] * HomingFeatures.METRES_SCALE
         spread = f[HomingFeatures.SPREAD] * HomingFeatures.SPREAD_SCALE_DEG
@@ -69,6 +84,10 @@ class HomingFeatureExpert:
             return np.array([-1.0, 0.0, 1.0], np.float32)
         bearing = math.degrees(math.atan2(left, fwd))
         turn = float(np.clip(2.5 * bearing, -60.0, 60.0)) / self.max_turn_deg_s
+        if self.previous_action and abs(bearing) > self.BEHIND_DEG:
+            last_turn = float(f[PreviousAction.PREVIOUS_ACTION][1])
+            if abs(last_turn) >= 0.5:  # keep turning the way it was turning
+                turn = math.copysign(60.0 / self.max_turn_deg_s, last_turn)
         speed = 0.0 if abs(bearing) > 30 else min(0.25, 0.8 * dist)
         walk = speed / self.max_forward if speed > 0 else -1.0  # StopAction: max(a, 0)
         return np.array([np.clip(walk, -1, 1), np.clip(turn, -1, 1), -1.0], np.float32)

@@ -7,7 +7,7 @@ without it.
 from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
-from vc_gym.envs.homing import HomingFeatures, StopAction, make_homing_env
+from vc_gym.envs.homing import HomingFeatures, PreviousAction, StopAction, make_homing_env
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.learning import (
     GridLearning,
@@ -39,6 +39,7 @@ __all__ = [
     "GridLearning",
     "HeadCameraSpec",
     "HomingFeatures",
+    "PreviousAction",
     "LEARNING_MODES",
     "LearnThenHomeEnv",
     "Learner",

@@ -25,6 +25,7 @@ __all__ = [
     "MAX_HOME_OFFSET_M",
     "STOP_THRESHOLD",
     "HomingFeatures",
+    "PreviousAction",
     "StopAction",
     "goal_vector",
     "home_offset",
@@ -268,6 +269,49 @@ class StopAction(gym.Wrapper):
         return bool(np.hypot(*home) > self.confirm_stop_m)
 
 
+class PreviousAction(gym.Wrapper):
+    """Append the last action taken (clipped to ``[-1, 1]``; zeros after a reset) to
+    :class:`StopAction`'s feature vector: ``[..., walk, turn, stop]``.
+
+    A memoryless policy cannot keep a turn going: with the goal right behind it, its
+    turn is a smooth fit of a rule that changes sign at a bearing of 180°, so it is slow
+    exactly there, and as the estimated goal moves round with the robot the bearing
+    crosses 180° again and again and the turn reverses (README, *Learned agents*,
+    turning on the spot). With its last action in view, a policy (and
+    :class:`~vc_gym.agents.HomingFeatureExpert` with ``previous_action=True``) can keep
+    turning the way it was turning.
+    """
+
+    #: Where the previous action lies in the vector.
+    PREVIOUS_ACTION = slice(-3, None)
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        space = env.observation_space
+        if not isinstance(space, spaces.Box) or len(space.shape) != 1:
+            raise ValueError(f"PreviousAction needs a feature vector env, got {space}")
+        # the same bounds as the features' (what a saved model's space is checked against)
+        self.observation_space = spaces.Box(-10.0, 10.0, (space.shape[0] + 3,), np.float32)
+
+    def reset(self, **kwargs: Any):
+        obs, info = self.env.reset(**kwargs)
+        return self._with(obs, np.zeros(3)), info
+
+    def step(self, action):
+        obs, r, terminated, truncated, info = self.env.step(action)  # checks the action
+        return (
+            self._with(obs, np.clip(np.asarray(action, np.float64), -1.0, 1.0)),
+            r,
+            terminated,
+            truncated,
+            info,
+        )
+
+    @staticmethod
+    def _with(obs: np.ndarray, action: np.ndarray) -> np.ndarray:
+        return np.concatenate([obs, action]).astype(np.float32)
+
+
 def make_homing_env(
     tracker: TrackerSpec = "grid",
     max_forward: float = 0.4,
@@ -277,6 +321,7 @@ def make_homing_env(
     head_scan: bool = True,
     min_walk_m: float = 0.0,
     home_offset_m: Any = (0.0, 0.0),
+    previous_action: bool = False,
     **task_kwargs: Any,
 ) -> gym.Env:
     """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
@@ -295,14 +340,19 @@ def make_homing_env(
         :class:`StopAction` ignores stop requests until the robot has walked this far.
     home_offset_m : (float, float)
         :class:`HomingFeatures`' goal, relative to the atlas' home (world frame, m).
+    previous_action : bool
+        Append the last action to the features (:class:`PreviousAction`). Default False.
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
     """
     home_offset_m = home_offset(home_offset_m)  # refused before a world is built
+    if not isinstance(previous_action, (bool, np.bool_)):
+        raise ValueError(f"previous_action must be True or False, got {previous_action!r}")
     env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
     env = CompassObservation(env, keep_image=False, tracker=tracker)
     env = HomingFeatures(env, home_offset_m)
-    return StopAction(
+    env = StopAction(
         env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m, head_scan, min_walk_m
     )
+    return PreviousAction(env) if previous_action else env

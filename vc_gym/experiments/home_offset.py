@@ -40,7 +40,7 @@ import numpy as np
 from tqdm import tqdm
 
 from vc_gym.agents.feature_expert import HomingFeatureExpert
-from vc_gym.envs.homing import MAX_HOME_OFFSET_M, home_offset
+from vc_gym.envs.homing import MAX_HOME_OFFSET_M, PreviousAction, home_offset
 from vc_gym.envs.learning import HOME
 
 __all__ = ["HomeOffset", "centre_home_offset", "measure_home_offset"]
@@ -217,10 +217,21 @@ def _checked_envs(envs: gym.Env | Sequence[gym.Env], episodes: int, caller: str)
 
 
 def _default_expert(env: gym.Env) -> HomingFeatureExpert:
-    """The scripted rule at the env's walking speed and turn rate."""
+    """The scripted rule at the env's walking speed and turn rate (reading its last
+    action when the env's features hold it)."""
     return HomingFeatureExpert(
-        _homing_attr(env, "max_forward"), _homing_attr(env, "max_turn_deg_s")
+        _homing_attr(env, "max_forward"),
+        _homing_attr(env, "max_turn_deg_s"),
+        previous_action=_has_wrapper(env, PreviousAction),
     )
+
+
+def _has_wrapper(env: gym.Env, kind: type) -> bool:
+    while isinstance(env, gym.Wrapper):
+        if isinstance(env, kind):
+            return True
+        env = env.env
+    return False
 
 
 def _homing_round(

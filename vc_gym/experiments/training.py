@@ -104,6 +104,13 @@ class TrainConfig:
         Stop requests are ignored until the robot has walked this far by its own
         forward commands (``min_walk_m`` of ``vc_gym/Homing-v0``). Default 0. A
         ``config.json`` saved before the field existed was trained with 0.
+    previous_action : bool
+        The policy also sees its last action (``previous_action`` of
+        ``vc_gym/Homing-v0``, :class:`~vc_gym.envs.PreviousAction`), and the expert it is
+        warm-started from keeps a turn going while home is behind, so that the clone can
+        learn to turn through rather than stall with home behind it (README, *Learned
+        agents*). Default False; a ``config.json`` saved before the field existed was
+        trained without it.
     home_offset_episodes : int
         Before the warm start, the scripted expert homes this many times in each of the
         training place(s) and ``home_offset_places`` more, and the median ``estimate −
@@ -185,6 +192,7 @@ class TrainConfig:
     confirm_stop_m: float | None = LEARNED_CONFIRM_STOP_M
     closeness_bonus: float = 0.0
     min_walk_m: float = 0.0
+    previous_action: bool = False
     home_offset_episodes: int = DEFAULT_HOME_OFFSET_EPISODES
     home_offset_places: int = 3
     home_offset_centre: bool = False
@@ -252,6 +260,8 @@ class TrainConfig:
             raise ValueError(
                 f"home_offset_places must be at most {MAX_PLACES}, got {self.home_offset_places}"
             )
+        if not isinstance(self.previous_action, (bool, np.bool_)):
+            raise ValueError(f"previous_action must be True or False, got {self.previous_action!r}")
         if not isinstance(self.home_offset_centre, (bool, np.bool_)):
             raise ValueError(
                 f"home_offset_centre must be True or False, got {self.home_offset_centre!r}"
@@ -332,6 +342,8 @@ class TrainConfig:
                 checked[name] = getattr(self, name)
         if self.home_offset_m is not None and self.home_offset_m != (0.0, 0.0):
             checked["home_offset_m"] = list(self.home_offset_m)
+        if self.previous_action:
+            checked["previous_action"] = True
         return {
             "scene": self.scene,
             "learn_time_s": self.learn_time_s,
@@ -359,6 +371,7 @@ class TrainConfig:
         data.setdefault("confirm_stop_m", None)
         data.setdefault("closeness_bonus", 0.0)
         data.setdefault("min_walk_m", 0.0)
+        data.setdefault("previous_action", False)
         data.setdefault("home_offset_episodes", 0)
         data.setdefault("home_offset_places", 0)
         data.setdefault("home_offset_centre", False)
@@ -697,7 +710,9 @@ def _measure_goal(
 
 def _warm_start(model: Any, venv: Any, config: TrainConfig, progress: bool) -> dict[str, Any]:
     """Clone the scripted expert into ``model``'s policy (see :mod:`.imitation`)."""
-    expert = HomingFeatureExpert(config.max_forward, config.max_turn_deg_s)
+    expert = HomingFeatureExpert(
+        config.max_forward, config.max_turn_deg_s, previous_action=config.previous_action
+    )
     demos = collect_demonstrations(venv, expert, config.demo_episodes, config.gamma, progress)
     fit = clone_behaviour(model.policy, demos, seed=config.seed)
     errors = [e["stop_error_m"] for e in demos.episodes]
