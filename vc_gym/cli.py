@@ -775,11 +775,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--previous-action",
-        action="store_true",
+        action=argparse.BooleanOptionalAction,
         default=None,
         help="the policy also sees its last action, and the expert it is warm-started from "
         "keeps a turn going while home is behind it (against turning on the spot with "
-        "home behind; default off)",
+        "home behind; default on)",
     )
     p.add_argument(
         "--home-offset-episodes",
@@ -788,8 +788,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="before the warm start the scripted expert homes N times in each training "
         "place and --home-offset-places more; the median of (tracker's position - true "
         "position) at its stops becomes the policy's goal, so that it stops at the true "
-        "home, not where the tracker puts home (DIR/home_offset.json; default 0: the "
-        "tracker's home; README, Learned agents, compares 10)",
+        "home, not where the tracker puts home (DIR/home_offset.json; default 10; 0: the "
+        "tracker's home, with --no-home-offset-centre)",
     )
     p.add_argument(
         "--home-offset-places",
@@ -800,12 +800,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--home-offset-centre",
-        action="store_true",
+        action=argparse.BooleanOptionalAction,
         default=None,
         help="then let the expert home again on the same kidnappings going to the measured "
         "goal, and move the goal so that its median stop lies at the true home (a secant "
-        "step per axis; the stops can move further than the goal did; needs "
-        "--home-offset-episodes)",
+        "step per axis; the stops can move further than the goal did; default on; needs "
+        "--home-offset-episodes of 1 or more)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

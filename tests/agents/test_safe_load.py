@@ -50,7 +50,9 @@ def test_the_shipped_policy_loads_the_same_as_sb3_would():
 
     safe = load_sb3_model("ppo", PRETRAINED_MODEL)
     plain = PPO.load(PRETRAINED_MODEL, device="cpu")
-    obs = np.random.default_rng(0).uniform(-2, 2, (8, 12)).astype(np.float32)
+    n_features = plain.observation_space.shape[0]
+    assert safe.observation_space == plain.observation_space
+    obs = np.random.default_rng(0).uniform(-2, 2, (8, n_features)).astype(np.float32)
     np.testing.assert_array_equal(
         safe.predict(obs, deterministic=True)[0], plain.predict(obs, deterministic=True)[0]
     )

@@ -28,7 +28,8 @@ TINY = TrainConfig(
     eval_episodes=2,
     save_freq=32,
     demo_episodes=0,
-    home_offset_episodes=0,
+    home_offset_episodes=0,  # the goal is the tracker's home: no measurement to wait for
+    home_offset_centre=False,
 )
 
 
@@ -410,9 +411,10 @@ def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
 
 
 def test_goal_correction_settings():
-    # the default goal is the tracker's home (measured best on learning seeds 10-12)
-    assert TrainConfig().home_offset_episodes == 0 and TrainConfig().home_offset_places == 3
-    assert "home_offset_m" not in TrainConfig(seed=0).env_kwargs()
+    # the default goal is measured and centred (README, Learned agents: learning seeds 30-32)
+    assert TrainConfig().home_offset_episodes == 10 and TrainConfig().home_offset_places == 3
+    assert TrainConfig().home_offset_centre is True and TrainConfig().home_offset_m is None
+    assert "home_offset_m" not in TrainConfig(seed=0).env_kwargs()  # until it is measured
     assert TrainConfig(seed=2).home_offset_seeds == (2, 2_000_032, 2_000_033, 2_000_034)
     given = replace(TINY, home_offset_m=(0.05, -0.1))
     assert given.env_kwargs()["home_offset_m"] == [0.05, -0.1]
@@ -424,7 +426,7 @@ def test_goal_correction_settings():
     }
     old = TrainConfig.from_dict(saved_before)
     assert old.home_offset_episodes == 0 and old.home_offset_m is None
-    assert old.home_offset_centre is False and TrainConfig().home_offset_centre is False
+    assert old.home_offset_centre is False
     centred = replace(TINY, home_offset_episodes=10, home_offset_centre=True)
     assert TrainConfig.from_dict(json.loads(json.dumps(centred.to_dict()))) == centred
     for bad in (
@@ -437,7 +439,7 @@ def test_goal_correction_settings():
         {"home_offset_m": "0.1,0.2"},
         {"home_offset_centre": "yes"},
         {"home_offset_centre": 1},
-        {"home_offset_centre": True},  # nothing measured to centre
+        {"home_offset_episodes": 0},  # nothing measured to centre (centring is the default)
     ):
         with pytest.raises(ValueError, match="home_offset"):
             TrainConfig(**bad)
@@ -446,6 +448,8 @@ def test_goal_correction_settings():
 def test_the_command_line_asks_for_a_centred_goal():
     assert build_parser().parse_args(["train", "--home-offset-centre"]).home_offset_centre
     assert build_parser().parse_args(["train"]).home_offset_centre is None  # the config's
+    off = build_parser().parse_args(["train", "--no-home-offset-centre", "--no-previous-action"])
+    assert off.home_offset_centre is False and off.previous_action is False
 
 
 def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
@@ -461,7 +465,7 @@ def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
         max_homing_s=20.0,
     )
     assert config.env_kwargs()["previous_action"] is True
-    assert "previous_action" not in TINY.env_kwargs()
+    assert "previous_action" not in replace(TINY, previous_action=False).env_kwargs()
     assert TrainConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
     summary = train(config, tmp_path, progress=False)
     assert summary["warm_start"]["demo_episodes"] == 1

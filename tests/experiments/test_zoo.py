@@ -35,6 +35,7 @@ def test_shipped_hyperparameters_are_vc_gym_train_defaults(algo):
     assert env["confirm_stop_m"] == d.confirm_stop_m
     assert env.get("closeness_bonus", 0.0) == d.closeness_bonus
     assert env.get("min_walk_m", 0.0) == d.min_walk_m
+    assert env.get("previous_action", False) == d.previous_action
     assert env["scene"] == d.scene and env["atlas_file"].endswith(".npz")
     with pytest.raises(ValueError, match="ppo and sac"):
         zoo_hyperparams("dqn")

@@ -111,6 +111,7 @@ def bench_train(
         learn_time_s=learn_time_s,
         demo_episodes=0,
         home_offset_episodes=0,
+        home_offset_centre=False,
     )
     runs = {}
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
