@@ -476,7 +476,8 @@ def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
     assert agent.predict(obs).shape == (3,)
     env.close()
     # a config.json saved before the field existed: trained without it
-    saved_before = {k: v for k, v in TINY.to_dict().items() if k != "previous_action"}
+    before = replace(TINY, previous_action=False).to_dict()  # its env has no such key
+    saved_before = {k: v for k, v in before.items() if k != "previous_action"}
     assert TrainConfig.from_dict(saved_before).previous_action is False
     with pytest.raises(ValueError, match="previous_action"):
         TrainConfig(previous_action="yes")
