@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
+from vc_gym.validation import (
+    finite_float,
+    flag,
+    int_at_least,
+    nonnegative_float,
+    positive_float,
+)
 
 
 @pytest.mark.parametrize("value", [1, 0.5, np.float32(2.0), np.int64(3)])
@@ -61,3 +67,10 @@ def test_int_at_least_refuses_small_values():
 def test_int_at_least_refuses_non_integers(value):
     with pytest.raises(ValueError, match=r"width must be an integer >= 2"):
         int_at_least("width", value, 2)
+
+
+def test_flag_takes_only_true_or_false():
+    assert flag("x", True) is True and flag("x", np.False_) is False
+    for bad in (1, 0, "yes", None, 1.0):
+        with pytest.raises(ValueError, match="x must be True or False"):
+            flag("x", bad)

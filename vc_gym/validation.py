@@ -5,11 +5,14 @@ from __future__ import annotations
 import math
 import numbers
 
+import numpy as np
+
 __all__ = [
     "MAX_ABS_DEG",
     "MAX_ABS_METRES",
     "finite_float",
     "finite_real",
+    "flag",
     "int_at_least",
     "nonnegative_float",
     "positive_float",
@@ -64,6 +67,14 @@ def nonnegative_float(name: str, value: object) -> float:
     if not (math.isfinite(v) and v >= 0):
         raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
     return v
+
+
+def flag(name: str, value: object) -> bool:
+    """``bool(value)`` for ``True`` or ``False`` (numpy's too), else a ``ValueError``:
+    a switch given ``1`` or ``"yes"`` is a mistake."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def int_at_least(name: str, value: object, minimum: int) -> int:

@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from vc_gym.envs.homing import HomingFeatures, PreviousAction
-from vc_gym.validation import positive_float
+from vc_gym.validation import flag, positive_float
 
 __all__ = ["HomingFeatureExpert"]
 
@@ -62,9 +62,7 @@ class HomingFeatureExpert:
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
         self.home_tolerance_m = positive_float("home_tolerance_m", home_tolerance_m)
         self.max_spread_deg = positive_float("max_spread_deg", max_spread_deg)
-        if not isinstance(previous_action, (bool, np.bool_)):
-            raise ValueError(f"previous_action must be True or False, got {previous_action!r}")
-        self.previous_action = bool(previous_action)
+        self.previous_action = flag("previous_action", previous_action)
 
     def predict(self, features: np.ndarray) -> np.ndarray:
         """``(walk, turn, stop)`` in ``[-1, 1]`` for one feature vector, or one row each

@@ -19,7 +19,7 @@ from gymnasium import spaces
 from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.localization import TrackerSpec
-from vc_gym.validation import finite_real, nonnegative_float, positive_float
+from vc_gym.validation import finite_real, flag, nonnegative_float, positive_float
 
 __all__ = [
     "MAX_HOME_OFFSET_M",
@@ -193,9 +193,7 @@ class StopAction(gym.Wrapper):
                     f"confirm_stop_m reads HomingFeatures' home vector; got observations {space}"
                 )
         self.confirm_stop_m = confirm_stop_m
-        if not isinstance(head_scan, (bool, np.bool_)):
-            raise ValueError(f"head_scan must be True or False, got {head_scan!r}")
-        self.head_scan = bool(head_scan)
+        self.head_scan = flag("head_scan", head_scan)
         self._pans = HEAD_SCAN_DEG
         self._scan_i = 0
         self._n = inner.shape[0]
@@ -347,8 +345,7 @@ def make_homing_env(
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
     """
     home_offset_m = home_offset(home_offset_m)  # refused before a world is built
-    if not isinstance(previous_action, (bool, np.bool_)):
-        raise ValueError(f"previous_action must be True or False, got {previous_action!r}")
+    flag("previous_action", previous_action)
     env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
     env = CompassObservation(env, keep_image=False, tracker=tracker)
     env = HomingFeatures(env, home_offset_m)

@@ -33,7 +33,7 @@ from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import make_tracker
 from vc_gym.persistence import write_atomic
-from vc_gym.validation import int_at_least, nonnegative_float, positive_float
+from vc_gym.validation import flag, int_at_least, nonnegative_float, positive_float
 
 __all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
 
@@ -261,12 +261,8 @@ class TrainConfig:
             raise ValueError(
                 f"home_offset_places must be at most {MAX_PLACES}, got {self.home_offset_places}"
             )
-        if not isinstance(self.previous_action, (bool, np.bool_)):
-            raise ValueError(f"previous_action must be True or False, got {self.previous_action!r}")
-        if not isinstance(self.home_offset_centre, (bool, np.bool_)):
-            raise ValueError(
-                f"home_offset_centre must be True or False, got {self.home_offset_centre!r}"
-            )
+        flag("previous_action", self.previous_action)
+        flag("home_offset_centre", self.home_offset_centre)
         if self.home_offset_m is not None:
             object.__setattr__(self, "home_offset_m", home_offset(self.home_offset_m))
         elif self.home_offset_centre and not self.home_offset_episodes:
