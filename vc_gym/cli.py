@@ -599,9 +599,10 @@ def build_parser() -> argparse.ArgumentParser:
             "a local Ray instance of --workers CPUs (atlas learned once; the results must be "
             "byte-identical). train: agent decisions per second of PPO training with --n-envs "
             "workers, once with SB3's lockstep collector and once with the asynchronous one, "
-            "next to one vc_gym/Homing-v0 stepping alone (before and after, same run), and "
-            "their ratios (efficiency; target 0.7). The last line of --json output is one "
-            "JSON object."
+            "next to one vc_gym/Homing-v0 stepping alone (timed with the same actions before "
+            "the first training and after each, in the same run; each training against the "
+            "rounds either side of it), and their ratios (efficiency; target 0.7). The last "
+            "line of --json output is one JSON object."
         ),
     )
     p.add_argument(

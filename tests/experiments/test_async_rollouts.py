@@ -64,6 +64,38 @@ def test_each_env_fills_its_own_consecutive_rows():
         venv.close()
 
 
+@pytest.mark.parametrize("shared", [True, False])
+def test_an_action_is_sb3s_distribution_and_value_to_the_bit(shared):
+    from toy_envs import CountingEnv
+
+    model = AsyncRolloutPPO(
+        "MlpPolicy",
+        CountingEnv(0),
+        n_steps=N_STEPS,
+        seed=5,
+        device="cpu",
+        policy_kwargs={"share_features_extractor": shared, "log_std_init": -0.5},
+    )
+    with torch.no_grad():  # trained-looking weights, not the initial ones
+        for p in model.policy.parameters():
+            p.add_(0.3 * torch.randn_like(p))
+    obs = np.random.default_rng(0).uniform(-3, 3, (20, 3)).astype(np.float32)
+    acted = [model._act(o, 0) for o in obs]
+    model._env_generators = None  # the same noise again, for SB3's own path
+    for o, (action, value, log_prob) in zip(obs, acted, strict=True):
+        obs_t = torch.as_tensor(o[None])
+        with torch.no_grad():
+            dist = model.policy.get_distribution(obs_t)
+            gen = model._generators(1)[0]
+            noise = torch.randn(dist.distribution.loc.shape, generator=gen)
+            expected = dist.distribution.loc + dist.distribution.scale * noise
+            assert np.array_equal(action, expected[0].numpy())
+            assert log_prob == float(dist.log_prob(expected)[0])
+            assert value == float(model.policy.predict_values(obs_t)[0, 0])
+    # and the noise differs between draws (the test could fail)
+    assert not np.array_equal(acted[0][0], acted[1][0])
+
+
 def test_the_policy_does_not_depend_on_which_worker_is_slower():
     results = []
     for delays in ([0.0, 0.006], [0.006, 0.0]):

@@ -125,18 +125,27 @@ def test_the_speed_benchmark_reports_training_next_to_the_env():
     from vc_gym.experiments.bench_train import bench_train
 
     r = bench_train(timesteps=32, n_envs=1, env_steps=10, learn_time_s=0.2, progress=False)
-    assert r["n_envs"] == 1 and len(r["env_rounds_decisions_per_s"]) == 2
-    assert r["env_decisions_per_s"] > 0 and r["env_task_steps_per_decision"] >= 1.0
-    assert set(r["collectors"]) == {"lockstep", "async"}
-    for c in r["collectors"].values():
+    # the env is timed before the first training and after each (2 collectors)
+    rounds, task_rounds = r["env_rounds_decisions_per_s"], r["env_rounds_task_steps_per_s"]
+    assert r["n_envs"] == 1 and len(rounds) == len(task_rounds) == 3
+    assert r["env_decisions_per_s"] == pytest.approx(np.median(rounds), rel=0.01)
+    assert r["env_task_steps_per_decision"] >= 1.0
+    assert list(r["collectors"]) == ["lockstep", "async"]  # the order they trained in
+    for k, c in enumerate(r["collectors"].values()):
+        # each collector against the rounds either side of its training
+        assert c["env_decisions_per_s"] == pytest.approx(np.mean(rounds[k : k + 2]), rel=0.01)
+        assert c["env_task_steps_per_s"] == pytest.approx(np.mean(task_rounds[k : k + 2]), rel=0.01)
         assert c["train_decisions_per_s"] > 0
         assert c["efficiency"] == pytest.approx(
-            c["train_decisions_per_s"] / r["env_decisions_per_s"], rel=0.01
+            c["train_decisions_per_s"] / c["env_decisions_per_s"], rel=0.01
         )
         # a decision is at least one task-env step (a stop that stands is many)
         assert c["train_task_steps_per_decision"] >= 1.0
         assert c["task_step_efficiency"] == pytest.approx(
-            c["train_task_steps_per_s"] / r["env_task_steps_per_s"], rel=0.01
+            c["train_task_steps_per_s"] / c["env_task_steps_per_s"], rel=0.01
+        )
+        assert c["decisions_over_task_steps"] == pytest.approx(
+            c["train_decisions_per_s"] / c["env_task_steps_per_s"], rel=0.01
         )
     assert r["async_over_lockstep"] == pytest.approx(
         r["collectors"]["async"]["train_decisions_per_s"]

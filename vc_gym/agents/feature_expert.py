@@ -70,7 +70,9 @@ class HomingFeatureExpert:
         f = np.asarray(features, dtype=np.float64)
         if f.ndim == 2:
             return np.stack([self.predict(row) for row in f]).astype(np.float32)
-        shortest = HomingFeatures.GOODNESS_START + (3 if self.previous_action else 0)
+        shortest = HomingFeatures.GOODNESS_START + (
+            PreviousAction.WIDTH if self.previous_action else 0
+        )
         if f.ndim != 1 or f.shape[0] <= shortest or not np.all(np.isfinite(f)):
             raise ValueError(f"expected one finite Homing-v0 feature vector, got shape {f.shape}")
         fwd, left = f[HomingFeatures.HOME_VECTOR] * HomingFeatures.METRES_SCALE

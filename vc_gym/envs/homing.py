@@ -280,8 +280,10 @@ class PreviousAction(gym.Wrapper):
     turning the way it was turning.
     """
 
+    #: Entries the previous action adds: ``(walk, turn, stop)``.
+    WIDTH = 3
     #: Where the previous action lies in the vector.
-    PREVIOUS_ACTION = slice(-3, None)
+    PREVIOUS_ACTION = slice(-WIDTH, None)
 
     def __init__(self, env: gym.Env):
         super().__init__(env)
@@ -289,11 +291,11 @@ class PreviousAction(gym.Wrapper):
         if not isinstance(space, spaces.Box) or len(space.shape) != 1:
             raise ValueError(f"PreviousAction needs a feature vector env, got {space}")
         # the same bounds as the features' (what a saved model's space is checked against)
-        self.observation_space = spaces.Box(-10.0, 10.0, (space.shape[0] + 3,), np.float32)
+        self.observation_space = spaces.Box(-10.0, 10.0, (space.shape[0] + self.WIDTH,), np.float32)
 
     def reset(self, **kwargs: Any):
         obs, info = self.env.reset(**kwargs)
-        return self._with(obs, np.zeros(3)), info
+        return self._with(obs, np.zeros(self.WIDTH)), info
 
     def step(self, action):
         obs, r, terminated, truncated, info = self.env.step(action)  # checks the action

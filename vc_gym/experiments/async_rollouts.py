@@ -18,6 +18,7 @@ whatever the machine is doing.
 
 from __future__ import annotations
 
+import math
 import multiprocessing.connection
 from typing import Any
 
@@ -33,6 +34,8 @@ except ImportError as exc:  # pragma: no cover - the [rl] extra is what installs
     raise ImportError("async rollouts need stable-baselines3: pip install 'vc_gym[rl]'") from exc
 
 __all__ = ["AsyncRolloutPPO", "AsyncSubprocVecEnv", "WorkerDiedError"]
+
+_LOG_SQRT_2PI = math.log(math.sqrt(2 * math.pi))
 
 
 class WorkerDiedError(RuntimeError):
@@ -157,20 +160,31 @@ class AsyncRolloutPPO(PPO):
 
         One env at a time, never a batch of whichever envs happen to be ready: a
         matrix product may round differently with another batch size, and then the
-        policy would depend on timing.
+        policy would depend on timing. The arithmetic is SB3's ``get_distribution``,
+        ``DiagGaussianDistribution.log_prob`` and ``predict_values``, operation for
+        operation (the same numbers to the bit), in one pass through the networks and
+        without building a ``torch.distributions`` object: it runs in the parent at every
+        decision, on a core the workers share.
         """
+        policy = self.policy
+        if not isinstance(policy.action_dist, DiagGaussianDistribution):
+            raise ValueError("async rollouts need a Gaussian policy over Box actions")
         with th.no_grad():
-            obs_t = obs_as_tensor(obs[None], self.device)
-            dist = self.policy.get_distribution(obs_t)
-            if not isinstance(dist, DiagGaussianDistribution):
-                raise ValueError("async rollouts need a Gaussian policy over Box actions")
-            normal = dist.distribution
+            features = policy.extract_features(obs_as_tensor(obs[None], self.device))
+            if policy.share_features_extractor:
+                latent_pi, latent_vf = policy.mlp_extractor(features)
+            else:
+                latent_pi = policy.mlp_extractor.forward_actor(features[0])
+                latent_vf = policy.mlp_extractor.forward_critic(features[1])
+            mean = policy.action_net(latent_pi)
+            std = th.ones_like(mean) * policy.log_std.exp()
             gen = self._generators(self.env.num_envs)[env_index]
-            noise = th.randn(normal.loc.shape, generator=gen).to(normal.loc.dtype)
-            action = normal.loc + normal.scale * noise
-            log_prob = float(dist.log_prob(action)[0])
-            value = float(self.policy.predict_values(obs_t)[0, 0])
-        return action[0].cpu().numpy(), value, log_prob
+            noise = th.randn(mean.shape, generator=gen).to(mean.dtype)
+            action = mean + std * noise
+            # torch's Normal.log_prob, summed over the action's dimensions
+            log_prob = -((action - mean) ** 2) / (2 * std**2) - std.log() - _LOG_SQRT_2PI
+            value = float(policy.value_net(latent_vf)[0, 0])
+        return action[0].cpu().numpy(), value, float(log_prob.sum(dim=1)[0])
 
     def collect_rollouts(self, env, callback, rollout_buffer, n_rollout_steps: int) -> bool:
         """Fill ``rollout_buffer`` with ``n_rollout_steps`` transitions per env, stepping

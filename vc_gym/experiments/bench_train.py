@@ -5,19 +5,26 @@ the task, the compass and tracker, the feature and stop wrappers) stepping with 
 actions in this process, resets included, after its learning phase. ``train`` runs
 :func:`~vc_gym.experiments.training.train` (PPO, ``n_envs`` worker processes, the place
 learned once and shared) and reports its decisions per second while the policy trains.
-The env is measured before and after training (median of the rounds), in the same run.
-``efficiency`` = training decisions/s ÷ (``n_envs`` × env decisions/s): 1 would mean the
-workers never wait for each other or for the policy. Training runs once with each
-collector (``TrainConfig.collector``): SB3's lockstep, where every step waits for the
-slowest worker, and the asynchronous one (:mod:`vc_gym.experiments.async_rollouts`), where
-each worker steps as soon as it has its action.
+Training runs once with each collector (``TrainConfig.collector``): SB3's lockstep, where
+every step waits for the slowest worker, and the asynchronous one
+(:mod:`vc_gym.experiments.async_rollouts`), where each worker steps as soon as it has its
+action.
+
+The env is timed in a round before the first training and after each one, every round
+with the same actions, so rounds differ only by what the machine is doing; each
+collector is compared with the mean of the two rounds either side of it (a machine that
+slows down or speeds up during the run moves both). ``efficiency`` = training
+decisions/s ÷ (``n_envs`` × env decisions/s): 1 would mean the workers never wait for
+each other or for the policy.
 
 A decision is not a fixed amount of work: a stop that stands holds its decision for up
 to the whole stand (50 steps of the task env), and the policy stops more or less often
 as it learns. So the same is measured in steps of the task env
 (``StopAction``'s ``info["task_steps"]``): ``task_step_efficiency`` = training task
 steps/s ÷ (``n_envs`` × the env's task steps/s), with ``*_task_steps_per_decision``
-showing how much work a decision was in each.
+showing how much work a decision was in each. ``decisions_over_task_steps`` divides
+training decisions/s by ``n_envs`` × the env's task steps/s, the strictest reading: a
+decision that stands for many task steps still counts as one.
 """
 
 from __future__ import annotations
@@ -44,7 +51,8 @@ __all__ = ["bench_train"]
 
 
 def _env_rate(config: TrainConfig, run_dir: Path, steps: int, seed: int) -> tuple[float, float]:
-    """Decisions and task-env steps per second of one env with random actions."""
+    """Decisions and task-env steps per second of one env with random actions (the same
+    actions for the same ``seed``)."""
     env = training_env(config, run_dir)
     rng = np.random.default_rng(seed)
     task_steps = 0
@@ -82,11 +90,12 @@ def bench_train(
     n_envs : int
         Worker processes of the training runs.
     env_steps : int
-        Decisions of each single-env round (one round before training, one after).
+        Decisions of each single-env round (one before the first training and one after
+        each; every round takes the same actions).
     learn_time_s : float
         Learning time per direction of the (untimed) learning phase.
     seed : int
-        Seed of the learning phase, the env rounds and the training runs.
+        Seed of the learning phase, the env rounds' actions and the training runs.
     collectors : tuple of str
         ``TrainConfig.collector`` values to train with, one after the other in this run
         (default: SB3's lockstep and the asynchronous one).
@@ -94,11 +103,15 @@ def bench_train(
     Returns
     -------
     dict
-        ``env_decisions_per_s`` and ``env_task_steps_per_s`` (one env alone), and per
-        collector (``collectors``) ``train_decisions_per_s``, ``efficiency``, the same
-        in task-env steps (``train_task_steps_per_s``, ``task_step_efficiency``,
-        ``train_task_steps_per_decision``); with both collectors
-        ``async_over_lockstep``, the ratio of their decision rates; and the settings.
+        One env alone: ``env_rounds_decisions_per_s`` and ``env_rounds_task_steps_per_s``
+        (every round, in order), their medians ``env_decisions_per_s`` and
+        ``env_task_steps_per_s``, and ``env_task_steps_per_decision``. Per collector
+        (``collectors``): the env's rates around its training (the mean of the rounds
+        either side), ``train_decisions_per_s``, ``efficiency``, the same in task-env
+        steps (``train_task_steps_per_s``, ``task_step_efficiency``,
+        ``train_task_steps_per_decision``) and ``decisions_over_task_steps``. With both
+        collectors ``async_over_lockstep``, the ratio of their decision rates; and the
+        settings.
     """
     int_at_least("env_steps", env_steps, 1)
     collectors = tuple(collectors)
@@ -113,33 +126,40 @@ def bench_train(
         home_offset_episodes=0,
         home_offset_centre=False,
     )
-    runs = {}
+    runs, rounds = {}, []
     with tempfile.TemporaryDirectory(prefix="vc_gym_bench_train_") as tmp:
         # the place is learned once into the run folder, where train() finds it
         learn_places(config, tmp)
-        before = _env_rate(config, Path(tmp), env_steps, seed)
+        rounds.append(_env_rate(config, Path(tmp), env_steps, seed))
         for name in collectors:
             runs[name] = train(replace(config, collector=name), tmp, progress=progress)
-        after = _env_rate(config, Path(tmp), env_steps, seed + 1)
-    env_rate = float(np.median([before[0], after[0]]))
-    env_task_rate = float(np.median([before[1], after[1]]))
+            rounds.append(_env_rate(config, Path(tmp), env_steps, seed))
     per_collector = {}
-    for name, run in runs.items():
+    for k, (name, run) in enumerate(runs.items()):
+        # the env as fast as it was around this training: the rounds either side of it
+        env_rate = float(np.mean([rounds[k][0], rounds[k + 1][0]]))
+        env_task_rate = float(np.mean([rounds[k][1], rounds[k + 1][1]]))
         rate, task_rate = float(run["decisions_per_s"]), float(run["task_steps_per_s"])
         per_collector[name] = {
+            "env_decisions_per_s": round(env_rate, 2),
             "train_decisions_per_s": round(rate, 2),
             "efficiency": round(rate / (n_envs * env_rate), 3),
+            "env_task_steps_per_s": round(env_task_rate, 2),
             "train_task_steps_per_s": round(task_rate, 2),
             "task_step_efficiency": round(task_rate / (n_envs * env_task_rate), 3),
             "train_task_steps_per_decision": round(task_rate / rate, 3),
+            "decisions_over_task_steps": round(rate / (n_envs * env_task_rate), 3),
         }
+    decision_rates = [r[0] for r in rounds]
+    task_rates = [r[1] for r in rounds]
     result: dict[str, Any] = {
         "timesteps": timesteps,
         "n_envs": n_envs,
-        "env_decisions_per_s": round(env_rate, 2),
-        "env_rounds_decisions_per_s": [round(before[0], 2), round(after[0], 2)],
-        "env_task_steps_per_s": round(env_task_rate, 2),
-        "env_task_steps_per_decision": round(env_task_rate / env_rate, 3),
+        "env_decisions_per_s": round(float(np.median(decision_rates)), 2),
+        "env_rounds_decisions_per_s": [round(r, 2) for r in decision_rates],
+        "env_task_steps_per_s": round(float(np.median(task_rates)), 2),
+        "env_rounds_task_steps_per_s": [round(r, 2) for r in task_rates],
+        "env_task_steps_per_decision": round(float(np.sum(task_rates) / np.sum(decision_rates)), 3),
         "target_efficiency": 0.7,
         "collectors": per_collector,
     }
