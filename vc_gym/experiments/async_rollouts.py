@@ -1,39 +1,52 @@
-"""PPO rollouts without lockstep: every worker steps as soon as it has its next action.
+"""PPO rollouts without lockstep: every worker runs its own rollout with its own copy of
+the policy.
 
 stable-baselines3 steps its ``SubprocVecEnv`` workers in lockstep: a step ends when the
 slowest worker's does. A homing decision is not a fixed amount of work (a checked stop
 stands for up to the task's 5 s, 50 steps of the task env), so in lockstep the other
-worker idles through every stand (README, "Training"). Here each worker gets its next
-action the moment its previous step returns; the rollout waits for the workers only
-once, when every one of them has its ``n_steps`` transitions.
+worker idles through every stand (README, "Training"). Here each worker is sent the
+policy's weights at the start of a rollout and takes its ``n_steps`` decisions on its
+own, choosing each action itself: no worker waits for another, nor for the parent
+process and a round trip through a pipe at every decision. The rollout waits for the
+workers only once, when every one of them has its ``n_steps`` transitions.
 
 The rollout is the same as SB3's in what PPO learns from: ``n_steps`` consecutive
 transitions per env, all taken with the policy as it was when the rollout began, time
-limits bootstrapped with the value function. Only the order in which the workers'
-transitions arrive depends on timing, and nothing depends on that order: each env
-draws its actions from its own random stream (seeded from the model's seed, the env's
-index and the decisions so far), so a run with the same seed gives the same policy
-whatever the machine is doing.
+limits bootstrapped with the value function. Nothing depends on timing: each env draws
+its actions from its own random stream (seeded from the model's seed, the env's index
+and the decisions so far, kept by the model between rollouts), and an action is
+computed one env at a time with SB3's arithmetic to the bit, so a run with the same seed
+gives the same policy whatever the machine is doing, and the same as if the parent had
+chosen every action. The callbacks see the transitions in lockstep order once the
+rollout is in.
 """
 
 from __future__ import annotations
 
 import math
-import multiprocessing.connection
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 try:
+    import cloudpickle
     import torch as th
     from stable_baselines3 import PPO
     from stable_baselines3.common.distributions import DiagGaussianDistribution
+    from stable_baselines3.common.policies import ActorCriticPolicy
     from stable_baselines3.common.utils import obs_as_tensor
     from stable_baselines3.common.vec_env import SubprocVecEnv
 except ImportError as exc:  # pragma: no cover - the [rl] extra is what installs them
     raise ImportError("async rollouts need stable-baselines3: pip install 'vc_gym[rl]'") from exc
 
-__all__ = ["AsyncRolloutPPO", "AsyncSubprocVecEnv", "WorkerDiedError"]
+__all__ = [
+    "AsyncRolloutPPO",
+    "AsyncSubprocVecEnv",
+    "RolloutWorker",
+    "WorkerDiedError",
+    "policy_action",
+]
 
 _LOG_SQRT_2PI = math.log(math.sqrt(2 * math.pi))
 
@@ -42,18 +55,161 @@ class WorkerDiedError(RuntimeError):
     """A worker process of an :class:`AsyncSubprocVecEnv` ended while it was stepping."""
 
 
-class AsyncSubprocVecEnv(SubprocVecEnv):
-    """``SubprocVecEnv`` whose workers can also be stepped one at a time.
+def policy_action(
+    policy: ActorCriticPolicy, obs: np.ndarray, generator: th.Generator
+) -> tuple[np.ndarray, float, float]:
+    """A sampled action, its value and log-probability for one observation ``obs``, the
+    noise drawn from ``generator``.
 
-    :meth:`send_step` starts one worker's step; :meth:`ready_steps` returns the steps
-    that have finished, waiting for at least one. The lockstep ``step`` still works
-    between rollouts (the warm start's demonstrations use it) as long as no single
-    step is pending. Training uses it for the lockstep collector too: a worker that
-    died is then a :class:`WorkerDiedError`, in lockstep as when stepped alone, and
-    :meth:`close` does not hide it behind a ``BrokenPipeError``.
+    One env at a time, never a batch of whichever envs happen to be ready: a matrix
+    product may round differently with another batch size, and then the policy would
+    depend on timing. The arithmetic is SB3's ``get_distribution``,
+    ``DiagGaussianDistribution.log_prob`` and ``predict_values``, operation for operation
+    (the same numbers to the bit), in one pass through the networks and without building
+    a ``torch.distributions`` object.
+
+    Raises
+    ------
+    ValueError
+        If the policy is not a Gaussian over ``Box`` actions.
+    """
+    if not isinstance(policy.action_dist, DiagGaussianDistribution):
+        raise ValueError("async rollouts need a Gaussian policy over Box actions")
+    with th.no_grad():
+        features = policy.extract_features(obs_as_tensor(obs[None], policy.device))
+        if policy.share_features_extractor:
+            latent_pi, latent_vf = policy.mlp_extractor(features)
+        else:
+            latent_pi = policy.mlp_extractor.forward_actor(features[0])
+            latent_vf = policy.mlp_extractor.forward_critic(features[1])
+        mean = policy.action_net(latent_pi)
+        std = th.ones_like(mean) * policy.log_std.exp()
+        noise = th.randn(mean.shape, generator=generator).to(mean.dtype)
+        action = mean + std * noise
+        # torch's Normal.log_prob, summed over the action's dimensions
+        log_prob = -((action - mean) ** 2) / (2 * std**2) - std.log() - _LOG_SQRT_2PI
+        value = float(policy.value_net(latent_vf)[0, 0])
+    return action[0].cpu().numpy(), value, float(log_prob.sum(dim=1)[0])
+
+
+class RolloutWorker(gym.Wrapper):
+    """The env of one worker process, which can also run a whole rollout itself.
+
+    :meth:`collect_rollout` is what :class:`AsyncSubprocVecEnv` calls in the worker (through
+    SB3's ``env_method``); stepping and resetting are the wrapped env's.
+    """
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        self._policy: ActorCriticPolicy | None = None
+        self._policy_spec: bytes | None = None
+
+    def collect_rollout(
+        self,
+        policy_spec: bytes,
+        weights: dict[str, np.ndarray],
+        generator_state: th.Tensor,
+        obs: np.ndarray,
+        start: float,
+        n_steps: int,
+        gamma: float,
+    ) -> dict[str, Any]:
+        """Take ``n_steps`` decisions from ``obs`` with the policy ``policy_spec`` (its
+        class and constructor arguments, from the parent process) holding ``weights``.
+
+        Each finished episode is reset at once, its last observation in the step's
+        ``info["terminal_observation"]`` and a time limit bootstrapped with the value
+        function (``gamma``), as SB3's worker and ``collect_rollouts`` do.
+
+        Returns
+        -------
+        dict
+            Per step: ``observations``, ``actions``, ``rewards``, ``episode_starts``,
+            ``values``, ``log_probs``, ``infos``, ``dones``; then ``last_obs``,
+            ``last_start``, the noise stream's ``generator_state`` and the last reset's
+            ``reset_info``.
+        """
+        th.set_num_threads(1)  # a 64-wide MLP on one row: a second thread only spins
+        if policy_spec != self._policy_spec:
+            # sent by the parent process through its pipe, as SB3 sends the env itself
+            cls, kwargs = cloudpickle.loads(policy_spec)
+            self._policy, self._policy_spec = cls(**kwargs), policy_spec
+        policy = self._policy
+        policy.load_state_dict({k: th.from_numpy(v) for k, v in weights.items()})
+        policy.set_training_mode(False)
+        generator = th.Generator()
+        generator.set_state(generator_state)
+        low, high = self.action_space.low, self.action_space.high
+        out: dict[str, Any] = {
+            "observations": np.empty((n_steps, *np.shape(obs)), np.asarray(obs).dtype),
+            "actions": np.empty((n_steps, *self.action_space.shape), np.float32),
+            "rewards": np.empty(n_steps),
+            "episode_starts": np.empty(n_steps),
+            "values": np.empty(n_steps),
+            "log_probs": np.empty(n_steps),
+            "infos": [],
+            "dones": np.empty(n_steps, bool),
+        }
+        reset_info = None
+        for t in range(n_steps):
+            action, value, log_prob = policy_action(policy, np.asarray(obs), generator)
+            next_obs, reward, terminated, truncated, info = self.env.step(
+                np.clip(action, low, high)
+            )
+            reward, done = float(reward), bool(terminated or truncated)
+            info["TimeLimit.truncated"] = bool(truncated and not terminated)
+            if done:
+                info["terminal_observation"] = next_obs
+                if info["TimeLimit.truncated"]:
+                    # the episode was cut, not ended: bootstrap as SB3 does (its #633)
+                    terminal = policy.obs_to_tensor(next_obs)[0]
+                    with th.no_grad():
+                        reward += gamma * float(policy.predict_values(terminal)[0, 0])
+                next_obs, reset_info = self.env.reset()
+            out["observations"][t] = obs
+            out["actions"][t] = action
+            out["rewards"][t] = reward
+            out["episode_starts"][t] = start
+            out["values"][t] = value
+            out["log_probs"][t] = log_prob
+            out["infos"].append(info)
+            out["dones"][t] = done
+            obs, start = next_obs, float(done)
+        out.update(
+            last_obs=obs,
+            last_start=start,
+            generator_state=generator.get_state(),
+            reset_info=reset_info,
+        )
+        return out
+
+
+class _WithRolloutWorker:
+    """``env_fn`` whose env is wrapped in :class:`RolloutWorker` (picklable, for the
+    worker processes)."""
+
+    def __init__(self, env_fn):
+        self.env_fn = env_fn
+
+    def __call__(self) -> RolloutWorker:
+        return RolloutWorker(self.env_fn())
+
+
+class AsyncSubprocVecEnv(SubprocVecEnv):
+    """``SubprocVecEnv`` whose workers can also run a whole rollout on their own.
+
+    :meth:`collect_rollouts` sends every worker the policy and its rollout's start and
+    returns their transitions. The lockstep ``step`` still works between rollouts (the
+    warm start's demonstrations use it), and training uses this class for the lockstep
+    collector too: a worker that died is then a :class:`WorkerDiedError`, in lockstep as
+    in a rollout of its own, and :meth:`close` does not hide it behind a
+    ``BrokenPipeError``.
     """
 
     _DIED = (BrokenPipeError, ConnectionResetError, EOFError)
+
+    def __init__(self, env_fns, start_method: str | None = None):
+        super().__init__([_WithRolloutWorker(fn) for fn in env_fns], start_method)
 
     def step_async(self, actions: np.ndarray) -> None:
         """SB3's lockstep step; a worker that has ended is a :class:`WorkerDiedError`."""
@@ -73,18 +229,35 @@ class AsyncSubprocVecEnv(SubprocVecEnv):
                 "a training worker ended while stepping (see its error above)"
             ) from None
 
-    def send_step(self, index: int, action: np.ndarray) -> None:
-        """Start worker ``index``'s step with ``action``.
+    def collect_rollouts(self, requests: list[tuple]) -> list[dict[str, Any]]:
+        """Run :meth:`RolloutWorker.collect_rollout` with ``requests[i]`` (its arguments)
+        in every worker ``i`` at once; their results, in worker order.
 
         Raises
         ------
         WorkerDiedError
-            If the worker's process has ended.
+            If a worker's process ended (its env raised or it was killed).
         """
-        try:
-            self.remotes[index].send(("step", action))
-        except self._DIED:
-            raise WorkerDiedError(f"training worker {index} has ended") from None
+        if len(requests) != self.num_envs:
+            raise ValueError(f"one request per worker ({self.num_envs}), got {len(requests)}")
+        for i, (remote, request) in enumerate(zip(self.remotes, requests, strict=True)):
+            try:
+                remote.send(("env_method", ("collect_rollout", request, {})))
+            except self._DIED:
+                raise WorkerDiedError(f"training worker {i} has ended") from None
+        results = []
+        for i, remote in enumerate(self.remotes):
+            try:
+                results.append(remote.recv())
+            except self._DIED:
+                raise WorkerDiedError(
+                    f"training worker {i} ended while stepping (see its error above)"
+                ) from None
+        self.reset_infos = [
+            r["reset_info"] if r["reset_info"] is not None else old
+            for r, old in zip(results, self.reset_infos, strict=True)
+        ]
+        return results
 
     def close(self) -> None:
         """Close every worker; one that already ended is skipped (its error stays the
@@ -100,37 +273,9 @@ class AsyncSubprocVecEnv(SubprocVecEnv):
             process.join()
         self.closed = True
 
-    def ready_steps(self, pending: set[int]) -> list[tuple[int, tuple]]:
-        """``[(index, (obs, reward, done, info))]`` of the pending workers that finished.
-
-        Blocks until at least one has. A finished episode's ``info`` holds
-        ``terminal_observation`` and ``obs`` is the next episode's first (as
-        ``SubprocVecEnv.step`` gives them); the reset's info goes to ``reset_infos``.
-
-        Raises
-        ------
-        WorkerDiedError
-            If a pending worker's process ended (its env raised or it was killed).
-        """
-        by_remote = {id(self.remotes[i]): i for i in pending}
-        ready = multiprocessing.connection.wait([self.remotes[i] for i in pending])
-        out = []
-        self.reset_infos = list(self.reset_infos)  # step_wait leaves a tuple
-        for remote in ready:
-            i = by_remote[id(remote)]
-            try:
-                obs, reward, done, info, reset_info = remote.recv()
-            except self._DIED:
-                raise WorkerDiedError(
-                    f"training worker {i} ended while stepping (see its error above)"
-                ) from None
-            self.reset_infos[i] = reset_info
-            out.append((i, (obs, float(reward), bool(done), info)))
-        return out
-
 
 class AsyncRolloutPPO(PPO):
-    """PPO whose rollouts step an :class:`AsyncSubprocVecEnv`'s workers independently.
+    """PPO whose rollouts each worker of an :class:`AsyncSubprocVecEnv` runs on its own.
 
     Everything else is SB3's PPO (the update, saving, loading: a saved model is an
     ordinary PPO ``model.zip``). With any other ``VecEnv`` it collects as PPO does.
@@ -155,101 +300,65 @@ class AsyncRolloutPPO(PPO):
         return gens
 
     def _act(self, obs: np.ndarray, env_index: int) -> tuple[np.ndarray, float, float]:
-        """A sampled action, its value and log-probability for env ``env_index``'s
-        observation ``obs``, the noise from that env's own stream.
-
-        One env at a time, never a batch of whichever envs happen to be ready: a
-        matrix product may round differently with another batch size, and then the
-        policy would depend on timing. The arithmetic is SB3's ``get_distribution``,
-        ``DiagGaussianDistribution.log_prob`` and ``predict_values``, operation for
-        operation (the same numbers to the bit), in one pass through the networks and
-        without building a ``torch.distributions`` object: it runs in the parent at every
-        decision, on a core the workers share.
-        """
-        policy = self.policy
-        if not isinstance(policy.action_dist, DiagGaussianDistribution):
-            raise ValueError("async rollouts need a Gaussian policy over Box actions")
-        with th.no_grad():
-            features = policy.extract_features(obs_as_tensor(obs[None], self.device))
-            if policy.share_features_extractor:
-                latent_pi, latent_vf = policy.mlp_extractor(features)
-            else:
-                latent_pi = policy.mlp_extractor.forward_actor(features[0])
-                latent_vf = policy.mlp_extractor.forward_critic(features[1])
-            mean = policy.action_net(latent_pi)
-            std = th.ones_like(mean) * policy.log_std.exp()
-            gen = self._generators(self.env.num_envs)[env_index]
-            noise = th.randn(mean.shape, generator=gen).to(mean.dtype)
-            action = mean + std * noise
-            # torch's Normal.log_prob, summed over the action's dimensions
-            log_prob = -((action - mean) ** 2) / (2 * std**2) - std.log() - _LOG_SQRT_2PI
-            value = float(policy.value_net(latent_vf)[0, 0])
-        return action[0].cpu().numpy(), value, float(log_prob.sum(dim=1)[0])
+        """:func:`policy_action` for env ``env_index``'s observation, from its own stream."""
+        return policy_action(self.policy, obs, self._generators(self.env.num_envs)[env_index])
 
     def collect_rollouts(self, env, callback, rollout_buffer, n_rollout_steps: int) -> bool:
-        """Fill ``rollout_buffer`` with ``n_rollout_steps`` transitions per env, stepping
-        every worker as soon as its previous step is back (SB3's contract otherwise)."""
+        """Fill ``rollout_buffer`` with ``n_rollout_steps`` transitions per env, every
+        worker running its own (SB3's contract otherwise)."""
         if not isinstance(env, AsyncSubprocVecEnv):
             return super().collect_rollouts(env, callback, rollout_buffer, n_rollout_steps)
         if self.use_sde or self.policy.squash_output:
             raise ValueError("async rollouts do not support gSDE or squashed actions")
+        if not isinstance(self.policy.action_dist, DiagGaussianDistribution):
+            raise ValueError("async rollouts need a Gaussian policy over Box actions")
         assert self._last_obs is not None, "No previous observation was provided"
         self.policy.set_training_mode(False)
         rollout_buffer.reset()
         callback.on_rollout_start()
         n_envs = env.num_envs
-        low, high = self.action_space.low, self.action_space.high
+        gens = self._generators(n_envs)
+        spec = cloudpickle.dumps((type(self.policy), self.policy._get_constructor_parameters()))
+        weights = {k: v.detach().cpu().numpy() for k, v in self.policy.state_dict().items()}
         last_obs = np.array(self._last_obs)
         starts = np.array(self._last_episode_starts, dtype=np.float32)
-        taken = np.zeros(n_envs, dtype=np.int64)
+        rollouts = env.collect_rollouts(
+            [
+                (
+                    spec,
+                    weights,
+                    gens[i].get_state(),
+                    last_obs[i],
+                    float(starts[i]),
+                    n_rollout_steps,
+                    float(self.gamma),
+                )
+                for i in range(n_envs)
+            ]
+        )
         rb = rollout_buffer
-        # the transition each pending worker is computing: (action, value, log_prob)
-        step_of: dict[int, tuple[np.ndarray, float, float]] = {}
-
-        def launch(i: int) -> None:
-            step_of[i] = self._act(last_obs[i], i)
-            env.send_step(i, np.clip(step_of[i][0], low, high))
-
-        # the callbacks see step t of every env once all have taken it, env by env, as
-        # after a lockstep step: what they record does not depend on timing either
-        ends: list[list[tuple[dict, bool] | None]] = [
-            [None] * n_envs for _ in range(n_rollout_steps)
-        ]
+        for i, r in enumerate(rollouts):
+            gens[i].set_state(r["generator_state"])
+            for key in (
+                "observations",
+                "actions",
+                "rewards",
+                "episode_starts",
+                "values",
+                "log_probs",
+            ):
+                getattr(rb, key)[:, i] = r[key]
+            last_obs[i], starts[i] = r["last_obs"], r["last_start"]
+        # the callbacks see step t of every env, env by env, as after a lockstep step
         base_timesteps = self.num_timesteps
-        called = 0
-        for i in range(n_envs):
-            launch(i)
-        while step_of:
-            for i, (obs, reward, done, info) in env.ready_steps(set(step_of)):
-                action, value, log_prob = step_of.pop(i)
-                if done and info.get("TimeLimit.truncated", False):
-                    # the episode was cut, not ended: bootstrap as SB3 does (its #633)
-                    terminal = self.policy.obs_to_tensor(info["terminal_observation"])[0]
-                    with th.no_grad():
-                        reward += self.gamma * float(self.policy.predict_values(terminal)[0, 0])
-                t = taken[i]
-                rb.observations[t, i] = last_obs[i]
-                rb.actions[t, i] = action
-                rb.rewards[t, i] = reward
-                rb.episode_starts[t, i] = starts[i]
-                rb.values[t, i] = value
-                rb.log_probs[t, i] = log_prob
-                ends[t][i] = (info, done)
-                taken[i] += 1
-                last_obs[i] = obs
-                starts[i] = float(done)
-                if taken[i] < n_rollout_steps:
-                    launch(i)
-            while called < n_rollout_steps and all(e is not None for e in ends[called]):
-                infos = [e[0] for e in ends[called]]
-                dones = np.array([e[1] for e in ends[called]])
-                called += 1
-                self.num_timesteps = base_timesteps + called * n_envs
-                callback.update_locals({"infos": infos, "dones": dones})
-                if not callback.on_step():
-                    self._drain(env, step_of)
-                    return False
-                self._update_info_buffer(infos, dones)
+        for t in range(n_rollout_steps):
+            infos = [r["infos"][t] for r in rollouts]
+            dones = np.array([r["dones"][t] for r in rollouts])
+            self.num_timesteps = base_timesteps + (t + 1) * n_envs
+            callback.update_locals({"infos": infos, "dones": dones})
+            if not callback.on_step():
+                return False
+            self._update_info_buffer(infos, dones)
         rb.pos, rb.full = n_rollout_steps, True
         self._last_obs = last_obs
         self._last_episode_starts = starts
@@ -259,10 +368,3 @@ class AsyncRolloutPPO(PPO):
         callback.update_locals({"infos": [], "dones": starts})
         callback.on_rollout_end()
         return True
-
-    @staticmethod
-    def _drain(env: AsyncSubprocVecEnv, step_of: dict[int, Any]) -> None:
-        """Collect the steps still running, so the env can be used (or closed) again."""
-        while step_of:
-            for i, _ in env.ready_steps(set(step_of)):
-                step_of.pop(i)
