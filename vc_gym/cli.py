@@ -239,7 +239,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                     f"decisions/s with {n} workers, efficiency {r['efficiency']:.2f} of {n} x "
                     f"the env's rate (target {result['target_efficiency']}); in task-env "
                     f"steps {r['train_task_steps_per_s']:.1f}/s, efficiency "
-                    f"{r['task_step_efficiency']:.2f}"
+                    f"{r['task_step_efficiency']:.2f} (decisions / task-env steps "
+                    f"{r['decisions_over_task_steps']:.2f})"
                 )
             if "async_over_lockstep" in result:
                 print(f"async / lockstep decisions/s: {result['async_over_lockstep']:.2f}")
@@ -736,9 +737,10 @@ def build_parser() -> argparse.ArgumentParser:
         "--collector",
         choices=["lockstep", "async"],
         help="how PPO collects rollouts from the workers: async (default with PPO and 2+ "
-        "workers; each worker steps as soon as it has its action: the same rollouts, faster "
-        "when a checked stop stands) or lockstep (SB3's: every step waits for the slowest "
-        "worker; the default otherwise, and what runs saved without this setting used)",
+        "workers; each worker runs its rollout on its own, choosing its actions itself: the "
+        "same rollouts, faster when a checked stop stands) or lockstep (SB3's: every step "
+        "waits for the slowest worker; the default otherwise, and what runs saved without "
+        "this setting used)",
     )
     p.add_argument(
         "--eval-freq",

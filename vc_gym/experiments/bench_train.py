@@ -7,8 +7,7 @@ actions in this process, resets included, after its learning phase. ``train`` ru
 learned once and shared) and reports its decisions per second while the policy trains.
 Training runs once with each collector (``TrainConfig.collector``): SB3's lockstep, where
 every step waits for the slowest worker, and the asynchronous one
-(:mod:`vc_gym.experiments.async_rollouts`), where each worker steps as soon as it has its
-action.
+(:mod:`vc_gym.experiments.async_rollouts`), where each worker runs its rollout on its own.
 
 The env is timed in a round before the first training and after each one, every round
 with the same actions, so rounds differ only by what the machine is doing; each

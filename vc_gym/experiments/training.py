@@ -139,7 +139,7 @@ class TrainConfig:
         ``"subproc"`` (``SubprocVecEnv``, forkserver) or ``"dummy"`` (in-process).
     collector : str, optional
         How PPO collects its rollouts from the ``"subproc"`` workers: ``"async"`` (each
-        worker steps as soon as it has its next action,
+        worker runs its rollout on its own, choosing its actions itself,
         :mod:`vc_gym.experiments.async_rollouts`; the same rollouts as SB3's, faster
         when decisions differ in cost, as a checked stop's stand does) or
         ``"lockstep"`` (SB3's: every step waits for the slowest worker). Default
@@ -583,8 +583,8 @@ def train(
     ]
     algo_cls = AsyncRolloutPPO if config.collector == "async" else algo
     if config.vec_env == "subproc":
-        # SB3's SubprocVecEnv that can also step single workers and closes past a dead
-        # one (its error is then the one raised, not a BrokenPipeError from close)
+        # SB3's SubprocVecEnv whose workers can also run whole rollouts, and which closes
+        # past a dead one (its error is then the one raised, not a BrokenPipeError)
         venv = AsyncSubprocVecEnv(factories, start_method="forkserver")
     else:
         venv = DummyVecEnv(factories)
