@@ -19,6 +19,7 @@ from vc_gym.experiments.async_rollouts import (  # noqa: E402
     AsyncRolloutPPO,
     AsyncSubprocVecEnv,
     WorkerDiedError,
+    policy_action,
 )
 from vc_gym.experiments.training import TrainConfig, train  # noqa: E402
 
@@ -80,7 +81,8 @@ def test_an_action_is_sb3s_distribution_and_value_to_the_bit(shared):
         for p in model.policy.parameters():
             p.add_(0.3 * torch.randn_like(p))
     obs = np.random.default_rng(0).uniform(-3, 3, (20, 3)).astype(np.float32)
-    acted = [model._act(o, 0) for o in obs]
+    gen = model._generators(1)[0]
+    acted = [policy_action(model.policy, o, gen) for o in obs]
     model._env_generators = None  # the same noise again, for SB3's own path
     for o, (action, value, log_prob) in zip(obs, acted, strict=True):
         obs_t = torch.as_tensor(o[None])
@@ -94,6 +96,49 @@ def test_an_action_is_sb3s_distribution_and_value_to_the_bit(shared):
             assert value == float(model.policy.predict_values(obs_t)[0, 0])
     # and the noise differs between draws (the test could fail)
     assert not np.array_equal(acted[0][0], acted[1][0])
+
+
+def test_a_rollout_is_the_same_as_the_parent_choosing_every_action():
+    import copy
+
+    from toy_envs import CountingEnv
+
+    model, venv = _model([0.0, 0.0])
+    try:
+        policy = copy.deepcopy(model.policy)  # the policy the rollout is taken with
+        gens = [copy.deepcopy(g) for g in model._generators(2)]
+        model.learn(total_timesteps=2 * N_STEPS)  # one rollout, then PPO's update
+        rb = model.rollout_buffer
+    finally:
+        venv.close()
+    low, high = model.action_space.low, model.action_space.high
+    truncations = 0
+    for i in range(2):  # replay env i here, every action chosen in this process
+        env = CountingEnv(i)
+        obs, _ = env.reset()
+        start, rows = 1.0, []
+        for _ in range(N_STEPS):
+            action, value, log_prob = policy_action(policy, obs, gens[i])
+            obs, reward, terminated, truncated, _ = env.step(np.clip(action, low, high))
+            if truncated:  # a cut episode is bootstrapped with the value of where it ended
+                truncations += 1
+                with torch.no_grad():
+                    end = policy.predict_values(torch.as_tensor(obs[None]))
+                reward += model.gamma * float(end[0, 0])
+            rows.append((action, value, log_prob, reward, start))
+            start = float(terminated or truncated)
+            if start:
+                obs, _ = env.reset()
+        # after the update the (step, env) rows are flattened env by env; the rewards and
+        # episode starts keep their layout
+        got = slice(i * N_STEPS, (i + 1) * N_STEPS)
+        action, value, log_prob, reward, start = map(np.array, zip(*rows, strict=True))
+        assert np.array_equal(rb.actions[got], action)
+        assert np.array_equal(rb.values[got].ravel(), value.astype(np.float32))
+        assert np.array_equal(rb.log_probs[got].ravel(), log_prob.astype(np.float32))
+        assert np.array_equal(rb.rewards[:, i], reward.astype(np.float32))
+        assert np.array_equal(rb.episode_starts[:, i], start.astype(np.float32))
+    assert truncations > 0  # the bootstrap was exercised
 
 
 def test_the_policy_does_not_depend_on_which_worker_is_slower():

@@ -299,10 +299,6 @@ class AsyncRolloutPPO(PPO):
             self._env_generators = gens
         return gens
 
-    def _act(self, obs: np.ndarray, env_index: int) -> tuple[np.ndarray, float, float]:
-        """:func:`policy_action` for env ``env_index``'s observation, from its own stream."""
-        return policy_action(self.policy, obs, self._generators(self.env.num_envs)[env_index])
-
     def collect_rollouts(self, env, callback, rollout_buffer, n_rollout_steps: int) -> bool:
         """Fill ``rollout_buffer`` with ``n_rollout_steps`` transitions per env, every
         worker running its own (SB3's contract otherwise)."""
