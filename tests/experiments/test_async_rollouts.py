@@ -73,6 +73,7 @@ def test_an_action_is_sb3s_distribution_and_value_to_the_bit(shared):
         "MlpPolicy",
         CountingEnv(0),
         n_steps=N_STEPS,
+        batch_size=N_STEPS,
         seed=5,
         device="cpu",
         policy_kwargs={"share_features_extractor": shared, "log_std_init": -0.5},
