@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 from dataclasses import replace
 
@@ -12,7 +13,7 @@ pytest.importorskip("stable_baselines3")
 
 import torch  # noqa: E402
 from test_training import TINY  # noqa: E402
-from toy_envs import counting_env  # noqa: E402
+from toy_envs import CountingEnv, counting_env  # noqa: E402
 
 from vc_gym.agents.learned import LearnedHomingAgent  # noqa: E402
 from vc_gym.experiments.async_rollouts import (  # noqa: E402
@@ -67,8 +68,6 @@ def test_each_env_fills_its_own_consecutive_rows():
 
 @pytest.mark.parametrize("shared", [True, False])
 def test_an_action_is_sb3s_distribution_and_value_to_the_bit(shared):
-    from toy_envs import CountingEnv
-
     model = AsyncRolloutPPO(
         "MlpPolicy",
         CountingEnv(0),
@@ -100,10 +99,6 @@ def test_an_action_is_sb3s_distribution_and_value_to_the_bit(shared):
 
 
 def test_a_rollout_is_the_same_as_the_parent_choosing_every_action():
-    import copy
-
-    from toy_envs import CountingEnv
-
     model, venv = _model([0.0, 0.0])
     try:
         policy = copy.deepcopy(model.policy)  # the policy the rollout is taken with
