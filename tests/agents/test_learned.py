@@ -83,7 +83,7 @@ def test_env_arguments_the_env_refuses_name_the_config_file(tmp_path, capsys, ch
 
 
 def test_shipped_policy_was_trained_with_the_default_settings():
-    # README: the shipped policy is seed 0 of `vc-gym train --seeds 0,1,2 --workers 1`;
+    # README: the shipped policy is seed 2 of `vc-gym train --seeds 0,1,2 --workers 1`;
     # a change of TrainConfig's defaults must re-ship it (or say why not)
     from dataclasses import replace
 
@@ -93,4 +93,4 @@ def test_shipped_policy_was_trained_with_the_default_settings():
     shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
     # the run measured its goal (centred); everything it was given is the defaults
     assert shipped.home_offset_m is not None and max(map(abs, shipped.home_offset_m)) < 0.3
-    assert replace(shipped, home_offset_m=None) == TrainConfig(seed=0)
+    assert replace(shipped, home_offset_m=None) == TrainConfig(seed=2)
