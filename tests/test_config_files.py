@@ -54,3 +54,44 @@ def test_huge_missing_and_binary_files_are_refused(tmp_path):
     with pytest.raises(ValueError, match="cannot read"):
         read_settings(binary)
     assert MAX_SETTINGS_DEPTH >= 5
+
+
+def _alias_bomb(levels: int = 9) -> str:
+    lines = ['a0: &a0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
+    for i in range(1, levels):
+        refs = ", ".join([f"*a{i - 1}"] * 10)
+        lines.append(f"a{i}: &a{i} [{refs}]")
+    return "\n".join(lines) + "\n"
+
+
+def test_a_yaml_alias_bomb_is_refused_at_once(tmp_path):
+    path = tmp_path / "bomb.yml"
+    path.write_text(_alias_bomb())
+    assert path.stat().st_size < 1000
+    with pytest.raises(ValueError, match="aliases") as err:
+        read_settings(path)
+    assert str(path) in str(err.value)
+
+
+def test_one_yaml_alias_is_refused_too(tmp_path):
+    path = tmp_path / "s.yml"
+    path.write_text("base: &b {gamma: 0.9}\nrun: *b\n")
+    with pytest.raises(ValueError, match="aliases"):
+        read_settings(path)
+
+
+@pytest.mark.parametrize(
+    ("name", "text"),
+    [
+        ("s.yml", "gamma: 0.9\nalgo: ppo\ngamma: 0.5\n"),
+        ("s.yml", "env:\n  scene: robolab\n  scene: office\n"),
+        ("s.json", '{"gamma": 0.9, "gamma": 0.5}'),
+        ("s.json", '{"env": {"scene": "robolab", "scene": "office"}}'),
+    ],
+)
+def test_a_key_given_twice_is_refused(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ValueError, match="appears twice") as err:
+        read_settings(path)
+    assert str(path) in str(err.value)

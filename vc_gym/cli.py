@@ -320,6 +320,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
         "data_dir": getattr(args, "data", None),
         "sensor": getattr(args, "sensor", None),
         "home_offset_m": getattr(args, "home_offset", None),
+        "allow_imports": getattr(args, "allow_imports", False) or None,
     }
     trackers = getattr(args, "tracker", None)
     if trackers:
@@ -339,6 +340,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
                 "max_homing_s": "max-homing",
                 "data_dir": "data",
                 "home_offset_m": "home-offset",
+                "allow_imports": "allow-imports",
             }.get(name, name)
             raise ValueError(f"experiment {args.name} does not take {flag}")
         options[name] = value
@@ -537,6 +539,18 @@ def _add_tracker_option(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _add_allow_imports_option(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument(
+        "--allow-imports",
+        action="store_true",
+        help=(
+            f"let {what} name plug-ins by import path ('package.module:factory'), which "
+            "imports and runs that code; without it a file may name only registered "
+            "plug-ins. Only for files you trust"
+        ),
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``vc-gym`` (exposed for documentation and tests)."""
     from vc_gym import __version__
@@ -648,6 +662,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="scripted|pretrained|DIR/model.zip",
         help="the scripted homing agent, the shipped PPO policy, or a model from vc-gym train",
     )
+    _add_allow_imports_option(p, "the agent's config.json")
     p.add_argument(
         "--relearn",
         choices=["scene", "episode"],
@@ -973,6 +988,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="homing, trackers: the agent (default scripted); agents: the agents to compare, "
         "comma-separated, scripted among them (default scripted,pretrained)",
     )
+    _add_allow_imports_option(p, "homing, agents: a learned agent's config.json")
     p.add_argument(
         "--tracker",
         action="append",

@@ -57,9 +57,8 @@ def test_bad_configs_are_clear_errors(tmp_path, config, match):
 @pytest.mark.parametrize(
     ("change", "match"),
     [
-        ({"extra_kw": 3}, "unexpected keyword argument 'extra_kw'"),
-        ({"scene": "nowhere"}, "unknown scene 'nowhere'"),
         ({"max_forward": -1}, "max_forward"),
+        ({"stop_time_s": "long"}, "stop_time_s"),
     ],
 )
 def test_env_arguments_the_env_refuses_name_the_config_file(tmp_path, capsys, change, match):
@@ -94,3 +93,97 @@ def test_shipped_policy_was_trained_with_the_default_settings():
     # the run measured its goal (centred); everything it was given is the defaults
     assert shipped.home_offset_m is not None and max(map(abs, shipped.home_offset_m)) < 0.3
     assert replace(shipped, home_offset_m=None) == TrainConfig(seed=2)
+
+
+def _copied_agent(tmp_path, change):
+    import shutil
+
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+
+    shutil.copytree(PRETRAINED_MODEL.parent, tmp_path / "agent")
+    cfg = tmp_path / "agent" / "config.json"
+    data = json.loads(cfg.read_text())
+    data["env"].update(change)
+    cfg.write_text(json.dumps(data))
+    return tmp_path / "agent" / "model.zip", cfg
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        ({"tracker": {"type": "os:system", "command": "touch {marker}"}}, "import path"),
+        ({"tracker": "os:abort"}, "import path"),
+        ({"tracker": "this:x"}, "import path"),
+        ({"tracker": {"type": "grid", "rule": {"deep": [[[[[[[[[[1]]]]]]]]]]}}}, "nested"),
+        ({"tracker": 3}, "registered name"),
+        ({"tracker": "nope"}, "unknown tracker 'nope'"),
+        ({"scene": "nowhere"}, "env.scene.*unknown scene 'nowhere'"),
+        ({"scene": "os:system"}, "env.scene"),
+        ({"extra_kw": 3}, "extra_kw"),
+        ({"learner": "os:system"}, "learner"),
+        ({"atlas_file": "/etc/passwd"}, "atlas_file"),
+    ],
+)
+def test_a_config_that_names_code_is_refused_before_anything_runs(tmp_path, change, match):
+    marker = tmp_path / "ran"
+    tracker = change.get("tracker")
+    if isinstance(tracker, dict) and "command" in tracker:
+        tracker["command"] = tracker["command"].format(marker=marker)
+    model, cfg = _copied_agent(tmp_path, change)
+    with pytest.raises(ValueError, match=match) as err:
+        LearnedHomingAgent(model)
+    assert str(cfg) in str(err.value)
+    assert not marker.exists()
+
+
+def test_the_command_refuses_a_config_that_names_code(tmp_path, capsys):
+    marker = tmp_path / "ran"
+    change = {"tracker": {"type": "os:system", "command": f"touch {marker}"}}
+    model, cfg = _copied_agent(tmp_path, change)
+    out = tmp_path / "run"
+    assert main(["evaluate", "--agent", str(model), "--episodes", "1", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert str(cfg) in err and "import path" in err
+    assert not marker.exists() and not out.exists()
+
+
+def test_an_import_path_is_read_when_the_user_allows_it(tmp_path):
+    spec = "vc_gym.localization.grid:GridTracker"
+    model, _ = _copied_agent(tmp_path, {"tracker": spec})
+    with pytest.raises(ValueError, match="import path"):
+        LearnedHomingAgent(model)
+    agent = LearnedHomingAgent(model, allow_imports=True)
+    assert agent.env_kwargs["tracker"] == spec
+
+
+def test_a_huge_config_is_refused_unread(tmp_path):
+    from vc_gym.config_files import MAX_SETTINGS_BYTES
+
+    model, cfg = _copied_agent(tmp_path, {})
+    data = json.loads(cfg.read_text())
+    data["padding"] = "x" * (MAX_SETTINGS_BYTES + 1)
+    cfg.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="more than a settings file may hold"):
+        LearnedHomingAgent(model)
+
+
+def test_the_command_line_can_allow_import_paths(tmp_path, monkeypatch, capsys):
+    import functools
+
+    import vc_gym.experiments.studies.homing as homing
+
+    seen = {}
+
+    @functools.wraps(homing.run_homing)  # the command checks its flags against this signature
+    def fake_run_homing(out_dir, opts=None, **kwargs):
+        seen.update(kwargs)
+        LearnedHomingAgent(kwargs["agent"], kwargs.get("allow_imports", False))
+        return {"overall": {}, "failed_jobs": []}
+
+    monkeypatch.setattr(homing, "run_homing", fake_run_homing)
+    model, _ = _copied_agent(tmp_path, {"tracker": "vc_gym.localization.grid:GridTracker"})
+    argv = ["evaluate", "--agent", str(model), "--episodes", "1", "--out", str(tmp_path / "r")]
+    assert main(argv) == 2
+    assert "import path" in capsys.readouterr().err
+    main([*argv, "--allow-imports"])
+    assert seen["allow_imports"] is True

@@ -113,3 +113,107 @@ def test_huge_and_garbage_files_are_refused(tmp_path):
         load_sb3_model("ppo", junk)
     with pytest.raises(ValueError, match="algo"):
         load_sb3_model("dqn", PRETRAINED_MODEL)
+
+
+def test_an_env_id_in_data_is_never_made(tmp_path, monkeypatch):
+    import gymnasium
+
+    made = []
+    monkeypatch.setattr(gymnasium, "make", lambda *a, **k: made.append(a))
+    bad = _rewrite(
+        PRETRAINED_MODEL,
+        tmp_path / "model.zip",
+        lambda d: d.update(env="vc_gym_no_such_module:Foo-v0"),
+    )
+    model = load_sb3_model("ppo", bad)
+    assert made == [] and model.env is None
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (lambda d: d["policy_kwargs"].update(net_arch=[10_000, 10_000]), "layer sizes"),
+        (lambda d: d["policy_kwargs"].update(net_arch=[64] * 20), "at most"),
+        (lambda d: d["policy_kwargs"].update(net_arch="64"), "list"),
+        (lambda d: d["policy_kwargs"].update(net_arch=[128, 128]), "do not match"),
+        (lambda d: d["policy_kwargs"].update(net_arch=[64]), "do not match"),
+        (lambda d: d["policy_kwargs"].update(activation_fn="os:system"), "activation_fn"),
+        (lambda d: d["policy_kwargs"].update(log_std_init=1e300), "log_std_init"),
+        (lambda d: d.update(n_steps=10**9), "n_steps"),
+        (lambda d: d.update(n_envs=100_000), "n_envs"),
+        (lambda d: d.update(batch_size=-1), "batch_size"),
+        (lambda d: d.update(gamma="0.9"), "gamma"),
+        (lambda d: d.update(learning_rate=float("nan")), "learning_rate"),
+        (lambda d: d.update(rollout_buffer_kwargs={"device": "cuda"}), "rollout_buffer_kwargs"),
+    ],
+)
+def test_plain_fields_out_of_bounds_are_refused_before_building(tmp_path, edit, message):
+    bad = _rewrite(PRETRAINED_MODEL, tmp_path / "model.zip", edit)
+    with pytest.raises(UnsafeModelError, match=message) as err:
+        load_sb3_model("ppo", bad)
+    assert str(bad) in str(err.value)
+
+
+def test_unknown_plain_fields_are_dropped_unread(tmp_path):
+    bad = _rewrite(
+        PRETRAINED_MODEL, tmp_path / "model.zip", lambda d: d.update(my_attribute=[1, 2, 3])
+    )
+    assert not hasattr(load_sb3_model("ppo", bad), "my_attribute")
+
+
+def test_a_huge_data_entry_is_refused(tmp_path):
+    from vc_gym.agents.safe_load import MAX_DATA_BYTES
+
+    bad = _rewrite(
+        PRETRAINED_MODEL, tmp_path / "model.zip", lambda d: d.update(pad="x" * MAX_DATA_BYTES)
+    )
+    with pytest.raises(UnsafeModelError, match="'data' entry is larger"):
+        load_sb3_model("ppo", bad)
+
+
+def test_weights_that_are_not_tensors_are_refused(tmp_path):
+    import io
+
+    import torch
+
+    buf = io.BytesIO()
+    torch.save({"log_std": [1, 2, 3]}, buf)
+    bad = _rewrite(PRETRAINED_MODEL, tmp_path / "model.zip")
+    with zipfile.ZipFile(PRETRAINED_MODEL) as zin, zipfile.ZipFile(bad, "w") as zout:
+        for info in zin.infolist():
+            content = buf.getvalue() if info.filename == "policy.pth" else zin.read(info)
+            zout.writestr(info.filename, content)
+    with pytest.raises(UnsafeModelError, match="policy.pth"):
+        load_sb3_model("ppo", bad)
+
+
+def test_a_sac_agent_loads_and_its_network_is_checked(tmp_path):
+    import gymnasium as gym
+    from gymnasium import spaces
+    from stable_baselines3 import SAC
+
+    class Features(gym.Env):
+        observation_space = spaces.Box(-10.0, 10.0, (15,), np.float32)
+        action_space = spaces.Box(-1.0, 1.0, (3,), np.float32)
+
+        def reset(self, seed=None, options=None):
+            super().reset(seed=seed)
+            return np.zeros(15, np.float32), {}
+
+        def step(self, action):
+            return np.zeros(15, np.float32), 0.0, False, False, {}
+
+    sac = SAC("MlpPolicy", Features(), policy_kwargs={"net_arch": [32, 16]}, buffer_size=64)
+    sac.save(tmp_path / "sac.zip")
+    loaded = load_sb3_model("sac", tmp_path / "sac.zip")
+    obs = np.linspace(-1, 1, 15, dtype=np.float32)
+    np.testing.assert_array_equal(
+        loaded.predict(obs, deterministic=True)[0], sac.predict(obs, deterministic=True)[0]
+    )
+    bad = _rewrite(
+        tmp_path / "sac.zip",
+        tmp_path / "bad.zip",
+        lambda d: d["policy_kwargs"].update(net_arch={"pi": [32, 16], "qf": [8]}),
+    )
+    with pytest.raises(UnsafeModelError, match="do not match"):
+        load_sb3_model("sac", bad)

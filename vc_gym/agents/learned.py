@@ -9,7 +9,6 @@ wrote.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
@@ -18,8 +17,20 @@ import gymnasium as gym
 import numpy as np
 
 from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
+from vc_gym.config_files import read_settings
+from vc_gym.envs.scenes.registry import check_scene_name
+from vc_gym.localization.registry import TRACKERS
+from vc_gym.plugins import check_file_spec, check_plain_data
 
-__all__ = ["ALGORITHMS", "ENV_KEYS", "PRETRAINED_MODEL", "LearnedHomingAgent", "algorithm_class"]
+__all__ = [
+    "ALGORITHMS",
+    "CONFIG_ENV_KEYS",
+    "ENV_KEYS",
+    "PRETRAINED_MODEL",
+    "LearnedHomingAgent",
+    "algorithm_class",
+    "read_agent_config",
+]
 
 ALGORITHMS = ("ppo", "sac")
 
@@ -33,6 +44,19 @@ ENV_KEYS = (
     "max_homing_s",
     "max_forward",
     "max_turn_deg_s",
+)
+
+#: Every ``vc_gym/Homing-v0`` argument an agent's ``config.json`` may set: what
+#: ``TrainConfig.env_kwargs`` writes. A file naming any other (a learner, an atlas file,
+#: a render mode) is refused before an env is built.
+CONFIG_ENV_KEYS = (
+    *ENV_KEYS,
+    "tracker",
+    "confirm_stop_m",
+    "closeness_bonus",
+    "min_walk_m",
+    "home_offset_m",
+    "previous_action",
 )
 
 #: The PPO policy shipped with the package (trained by ``vc-gym train``, see README);
@@ -52,13 +76,22 @@ def algorithm_class(name: str):
     return {"ppo": PPO, "sac": SAC}[name]
 
 
-def read_agent_config(path: Path) -> tuple[str, dict[str, Any]]:
-    """``(algo, Homing-v0 kwargs)`` from a training run's ``config.json``."""
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError, RecursionError) as exc:
-        raise ValueError(f"{path}: not a readable JSON config: {exc}") from None
-    if not isinstance(data, dict) or data.get("schema") not in (1, 2):
+def read_agent_config(path: Path, allow_imports: bool = False) -> tuple[str, dict[str, Any]]:
+    """``(algo, Homing-v0 kwargs)`` from a training run's ``config.json``.
+
+    The file is read with the bounded settings reader (size, depth, repeated keys), and
+    what it says is checked before anything is built from it: only the env arguments of
+    :data:`CONFIG_ENV_KEYS`, as plain data; a registered scene; a registered tracker
+    (a name or ``{"type": name, ...}``), an import path only with ``allow_imports``
+    (the person at the keyboard's choice, :func:`vc_gym.plugins.check_file_spec`).
+
+    Raises
+    ------
+    ValueError
+        Naming the file and the field.
+    """
+    data = read_settings(path)
+    if data.get("schema") not in (1, 2):
         raise ValueError(f"{path}: not a vc_gym training config (schema 1 or 2)")
     algo = data.get("algo")
     if algo not in ALGORITHMS:
@@ -66,6 +99,22 @@ def read_agent_config(path: Path) -> tuple[str, dict[str, Any]]:
     env = data.get("env") if data["schema"] == 2 else {k: data[k] for k in ENV_KEYS if k in data}
     if not isinstance(env, dict) or not all(isinstance(k, str) for k in env):
         raise ValueError(f"{path}: 'env' must be a dict of Homing-v0 arguments")
+    unknown = sorted(set(env) - set(CONFIG_ENV_KEYS))
+    if unknown:
+        raise ValueError(
+            f"{path}: field 'env' names {unknown}, which an agent's config may not set "
+            f"(accepted: {list(CONFIG_ENV_KEYS)})"
+        )
+    check_plain_data(env, f"{path}: field 'env'")
+    if "scene" in env:
+        try:
+            check_scene_name(env["scene"])
+        except ValueError as exc:
+            raise ValueError(f"{path}: field 'env.scene': {exc}") from None
+    if "tracker" in env:
+        check_file_spec(
+            env["tracker"], TRACKERS, "tracker", f"{path}: field 'env.tracker'", allow_imports
+        )
     return algo, env
 
 
@@ -76,16 +125,19 @@ class LearnedHomingAgent:
     ----------
     model_path : path
         The ``model.zip`` written by :func:`vc_gym.experiments.training.train`.
+    allow_imports : bool
+        Let the ``config.json`` name a tracker by import path (``"module:attr"``), which
+        imports that module: only for files you trust (:func:`read_agent_config`).
     """
 
-    def __init__(self, model_path: str | os.PathLike):
+    def __init__(self, model_path: str | os.PathLike, allow_imports: bool = False):
         path = Path(model_path)
         if path.suffix != ".zip" or not path.is_file():
             raise ValueError(f"{path}: not a model file (expected DIR/model.zip from train)")
         cfg_path = path.with_name("config.json")
         if not cfg_path.is_file():
             raise ValueError(f"{cfg_path}: missing (train writes it next to the model)")
-        self.algo, self.env_kwargs = read_agent_config(cfg_path)
+        self.algo, self.env_kwargs = read_agent_config(cfg_path, allow_imports)
         try:
             # never unpickles: a model file from anyone cannot run code here
             self.model = load_sb3_model(self.algo, path, device="cpu")

@@ -8,11 +8,21 @@ are already read with ``torch.load(weights_only=True)``. :func:`load_sb3_model` 
 entry, rebuilt from the entry's plain description (a Box's shape and bounds, a constant
 schedule's value) or a fresh default, so nothing is ever unpickled. Anything it does not
 know, or that does not describe a ``vc_gym/Homing-v0`` agent, is refused.
+
+Plain entries of ``data`` choose things too: SB3 copies every key onto the model
+(``"env": "module:Id-v0"`` would make it call ``gym.make``, which imports the module;
+``n_steps`` sizes the rollout buffer; ``policy_kwargs.net_arch`` sizes the networks).
+So only the keys a PPO or SAC homing agent needs are passed on (:data:`PLAIN_FIELDS`),
+each checked against its type and bounds; any other key is dropped unread. The
+network's layer sizes must match the shapes of the weights in ``policy.pth``, read
+with ``torch.load(weights_only=True)`` before any network is built.
 """
 
 from __future__ import annotations
 
+import io
 import json
+import math
 import os
 import re
 import zipfile
@@ -24,11 +34,32 @@ import numpy as np
 
 from vc_gym.persistence import zip_entries_problem
 
-__all__ = ["MAX_ENTRY_BYTES", "MAX_MODEL_BYTES", "UnsafeModelError", "load_sb3_model"]
+__all__ = [
+    "MAX_DATA_BYTES",
+    "MAX_ENTRY_BYTES",
+    "MAX_LAYERS",
+    "MAX_LAYER_WIDTH",
+    "MAX_MODEL_BYTES",
+    "PLAIN_FIELDS",
+    "UnsafeModelError",
+    "check_net_arch",
+    "load_sb3_model",
+]
 
 #: Largest uncompressed size of one entry of a model zip, and of all entries together.
 MAX_ENTRY_BYTES = 64_000_000
 MAX_MODEL_BYTES = 256_000_000
+#: Largest ``data`` entry (JSON; a trained agent's is about 20 kB).
+MAX_DATA_BYTES = 1_000_000
+#: Hidden layers of a policy or value network, and units per layer, at most (a
+#: 8 x 4096 MLP holds about 130 M weights, 0.5 GB).
+MAX_LAYERS = 8
+MAX_LAYER_WIDTH = 4096
+#: Parallel envs, rollout steps per env and replay-buffer transitions a loaded model
+#: may ask for (they size the buffers built on load).
+MAX_ENVS = 64
+MAX_ROLLOUT = 2**16
+MAX_REPLAY = 2_000_000
 #: Entries a stable-baselines3 PPO or SAC model zip may hold.
 _ENTRIES = {
     "data",
@@ -110,6 +141,240 @@ def _replacements(algo: str) -> dict[str, Callable[[dict[str, Any], str], Any]]:
     }
 
 
+def _int(lo: int, hi: int) -> Callable[[Any], bool]:
+    return lambda v: isinstance(v, int) and not isinstance(v, bool) and lo <= v <= hi
+
+
+def _float(lo: float, hi: float) -> Callable[[Any], bool]:
+    def check(v: Any) -> bool:
+        number = isinstance(v, int | float) and not isinstance(v, bool)
+        return number and math.isfinite(v) and lo <= v <= hi
+
+    return check
+
+
+def _bool(v: Any) -> bool:
+    return isinstance(v, bool)
+
+
+def _none(v: Any) -> bool:
+    return v is None
+
+
+def _either(*checks: Callable[[Any], bool]) -> Callable[[Any], bool]:
+    return lambda v: any(c(v) for c in checks)
+
+
+_COUNT = _int(0, 10**12)
+_AUTO = re.compile(r"^auto(_[0-9.eE+-]{1,20})?$")
+#: The plain (not pickled) ``data`` keys passed on to SB3, each with its check. Every
+#: other plain key is dropped unread.
+PLAIN_FIELDS: dict[str, Callable[[Any], bool]] = {
+    # every algorithm
+    "verbose": _int(0, 2),
+    "num_timesteps": _COUNT,
+    "_total_timesteps": _COUNT,
+    "_num_timesteps_at_start": _COUNT,
+    "seed": _either(_none, _int(-(2**63), 2**64)),
+    "action_noise": _none,
+    "start_time": _either(_int(0, 2**64), _float(0.0, 2.0**64)),
+    "learning_rate": _float(0.0, 1.0),
+    "_episode_num": _COUNT,
+    "use_sde": _bool,
+    "sde_sample_freq": _int(-1, 10**9),
+    "_current_progress_remaining": _float(-1.0, 1.0),
+    "_stats_window_size": _int(1, 10_000),
+    "_n_updates": _COUNT,
+    "n_envs": _int(1, MAX_ENVS),
+    "gamma": _float(0.0, 1.0),
+    "batch_size": _int(1, MAX_ROLLOUT),
+    "n_steps": _int(1, MAX_ROLLOUT),
+    # PPO
+    "gae_lambda": _float(0.0, 1.0),
+    "ent_coef": _either(_float(0.0, 1e3), lambda v: isinstance(v, str) and _AUTO.match(v)),
+    "vf_coef": _float(0.0, 1e3),
+    "max_grad_norm": _float(0.0, 1e6),
+    "rollout_buffer_kwargs": lambda v: v == {},
+    "n_epochs": _int(1, 1000),
+    "clip_range_vf": _either(_none, _float(0.0, 1e3)),
+    "normalize_advantage": _bool,
+    "target_kl": _either(_none, _float(0.0, 1e3)),
+    # SAC
+    "buffer_size": _int(1, MAX_REPLAY),
+    "learning_starts": _COUNT,
+    "tau": _float(0.0, 1.0),
+    "gradient_steps": _int(-1, 10_000),
+    "optimize_memory_usage": _bool,
+    "replay_buffer_kwargs": lambda v: v == {},
+    "use_sde_at_warmup": _bool,
+    "target_entropy": _either(_float(-1e6, 1e6), lambda v: v == "auto"),
+    "target_update_interval": _int(1, 10**6),
+    "batch_norm_stats": lambda v: v == [],
+    "batch_norm_stats_target": lambda v: v == [],
+    # checked on their own (check_net_arch)
+    "policy_kwargs": lambda v: isinstance(v, dict),
+}
+#: ``policy_kwargs`` keys a loaded model may set.
+_POLICY_KWARGS = {
+    "ppo": {"net_arch", "log_std_init", "use_sde"},
+    "sac": {"net_arch", "log_std_init", "use_sde", "n_critics"},
+}
+
+
+def check_net_arch(net_arch: Any, heads: tuple[str, ...] = ("pi", "vf")) -> dict[str, list[int]]:
+    """The hidden layers of each network in ``net_arch`` (SB3's list, or a dict by head).
+
+    Parameters
+    ----------
+    net_arch : list of int or dict
+        ``[64, 64]`` (the same layers for every head) or ``{"pi": [...], "vf": [...]}``
+        (SAC: ``"qf"`` for the critic).
+    heads : tuple of str
+        The algorithm's heads.
+
+    Raises
+    ------
+    ValueError
+        Layers that are not positive integers, more than :data:`MAX_LAYERS` of them or
+        wider than :data:`MAX_LAYER_WIDTH`, or a dict with other keys.
+    """
+
+    def layers(v: Any, what: str) -> list[int]:
+        if not isinstance(v, list | tuple) or len(v) > MAX_LAYERS:
+            raise ValueError(
+                f"{what} must be a list of at most {MAX_LAYERS} layer sizes, got {v!r}"
+            )
+        for n in v:
+            if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_LAYER_WIDTH:
+                raise ValueError(
+                    f"{what}: layer sizes must be integers from 1 to {MAX_LAYER_WIDTH}, got {n!r}"
+                )
+        return list(v)
+
+    if isinstance(net_arch, dict):
+        if set(net_arch) != set(heads):
+            raise ValueError(
+                f"net_arch as a dict must have the keys {list(heads)}, got {net_arch!r}"
+            )
+        return {h: layers(net_arch[h], f"net_arch[{h!r}]") for h in heads}
+    arch = layers(net_arch, "net_arch")
+    return {h: list(arch) for h in heads}
+
+
+def _mlp_shapes(prefix: str, n_in: int, hidden: list[int], n_out: int | None) -> dict:
+    """The parameter shapes of SB3's ``create_mlp`` (Linear layers at even indices)."""
+    shapes: dict[str, tuple[int, ...]] = {}
+    sizes = [n_in, *hidden] + ([n_out] if n_out is not None else [])
+    for i, (a, b) in enumerate(zip(sizes[:-1], sizes[1:], strict=True)):
+        shapes[f"{prefix}.{2 * i}.weight"] = (b, a)
+        shapes[f"{prefix}.{2 * i}.bias"] = (b,)
+    return shapes
+
+
+def _expected_shapes(algo: str, arch: dict[str, list[int]], n_obs: int, n_act: int, n_critics: int):
+    """Every parameter of an SB3 ``MlpPolicy`` and its shape, from the sizes alone."""
+    if algo == "ppo":
+        pi, vf = arch["pi"], arch["vf"]
+        last_pi, last_vf = (pi or [n_obs])[-1], (vf or [n_obs])[-1]
+        return {
+            "log_std": (n_act,),
+            **_mlp_shapes("mlp_extractor.policy_net", n_obs, pi, None),
+            **_mlp_shapes("mlp_extractor.value_net", n_obs, vf, None),
+            "action_net.weight": (n_act, last_pi),
+            "action_net.bias": (n_act,),
+            "value_net.weight": (1, last_vf),
+            "value_net.bias": (1,),
+        }
+    pi, qf = arch["pi"], arch["qf"]
+    last_pi = (pi or [n_obs])[-1]
+    shapes = {
+        **_mlp_shapes("actor.latent_pi", n_obs, pi, None),
+        "actor.mu.weight": (n_act, last_pi),
+        "actor.mu.bias": (n_act,),
+        "actor.log_std.weight": (n_act, last_pi),
+        "actor.log_std.bias": (n_act,),
+    }
+    for net in ("critic", "critic_target"):
+        for k in range(n_critics):
+            shapes.update(_mlp_shapes(f"{net}.qf{k}", n_obs + n_act, qf, 1))
+    return shapes
+
+
+def _weight_shapes(path: Path) -> dict[str, tuple[int, ...]]:
+    """The shape of every tensor in the zip's ``policy.pth`` (``weights_only``: no code)."""
+    import torch
+
+    with zipfile.ZipFile(path) as z:
+        raw = z.read("policy.pth")
+    try:
+        state = torch.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
+    except Exception as exc:  # noqa: BLE001 - torch raises many kinds on a bad file
+        raise UnsafeModelError(f"'policy.pth' is not a readable tensor file: {exc}") from None
+    if not isinstance(state, dict) or not all(hasattr(v, "shape") for v in state.values()):
+        raise UnsafeModelError("'policy.pth' is not a dict of tensors")
+    return {str(k): tuple(v.shape) for k, v in state.items()}
+
+
+def _plain_data(algo: str, data: dict[str, Any], path: Path) -> dict[str, Any]:
+    """The plain keys of ``data`` that are passed on, each checked; the network checked
+    against the weights' shapes."""
+    kept: dict[str, Any] = {}
+    for key, value in data.items():
+        if isinstance(value, dict) and ":serialized:" in value:
+            kept[key] = value  # replaced by a known object (custom_objects) or refused
+        elif key in PLAIN_FIELDS:
+            if not PLAIN_FIELDS[key](value):
+                raise UnsafeModelError(f"'data' field {key!r} = {value!r} is out of bounds")
+            kept[key] = value
+    kwargs = kept.get("policy_kwargs", {})
+    extra = set(kwargs) - _POLICY_KWARGS[algo]
+    if extra:
+        raise UnsafeModelError(f"'data' field 'policy_kwargs' sets {sorted(extra)}")
+    if "log_std_init" in kwargs and not _float(-20.0, 20.0)(kwargs["log_std_init"]):
+        raise UnsafeModelError("'data' field 'policy_kwargs.log_std_init' is out of bounds")
+    n_critics = kwargs.get("n_critics", 2)
+    if not _int(1, 10)(n_critics):
+        raise UnsafeModelError("'data' field 'policy_kwargs.n_critics' is out of bounds")
+    if "use_sde" in kwargs and not _bool(kwargs["use_sde"]):
+        raise UnsafeModelError("'data' field 'policy_kwargs.use_sde' is not a bool")
+    if kwargs.get("use_sde") or kept.get("use_sde"):
+        raise UnsafeModelError("generalised state-dependent exploration (use_sde) is not ours")
+    heads = ("pi", "vf") if algo == "ppo" else ("pi", "qf")
+    default = [64, 64] if algo == "ppo" else [256, 256]
+    try:
+        arch = check_net_arch(kwargs.get("net_arch", default), heads)
+    except ValueError as exc:
+        raise UnsafeModelError(f"'data' field 'policy_kwargs': {exc}") from None
+    shapes = {}
+    for name in ("observation_space", "action_space"):
+        shape = data.get(name, {}).get("_shape") if isinstance(data.get(name), dict) else None
+        if not (isinstance(shape, list) and len(shape) == 1 and _int(1, 4096)(shape[0])):
+            raise UnsafeModelError(f"{name}: not the Box a vc_gym/Homing-v0 agent uses")
+        shapes[name] = shape[0]
+    expected = _expected_shapes(
+        algo, arch, shapes["observation_space"], shapes["action_space"], n_critics
+    )
+    got = _weight_shapes(path)
+    if got != expected:
+        wrong = sorted(k for k in set(got) | set(expected) if got.get(k) != expected.get(k))
+        raise UnsafeModelError(
+            f"the weights in 'policy.pth' do not match the network 'data' describes "
+            f"(policy_kwargs {kwargs!r}): {len(wrong)} tensors differ, e.g. {wrong[:3]}"
+        )
+    return kept
+
+
+def _sanitised_zip(path: Path, data: dict[str, Any]) -> io.BytesIO:
+    """A copy of the model zip in memory whose ``data`` holds only ``data``."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(path) as zin, zipfile.ZipFile(buf, "w") as zout:
+        for info in zin.infolist():
+            content = json.dumps(data).encode() if info.filename == "data" else zin.read(info)
+            zout.writestr(info.filename, content)
+    buf.seek(0)
+    return buf
+
+
 def _checked_data(path: Path) -> dict[str, Any]:
     """The zip's ``data`` entry as plain JSON, after checking every entry's name and size."""
     try:
@@ -126,6 +391,8 @@ def _checked_data(path: Path) -> dict[str, Any]:
                     if unknown
                     else "no 'data' or 'policy.pth' entry"
                 )
+            if z.getinfo("data").file_size > MAX_DATA_BYTES:
+                raise UnsafeModelError(f"its 'data' entry is larger than {MAX_DATA_BYTES} bytes")
             text = z.read("data").decode("utf-8")
     except (OSError, zipfile.BadZipFile, UnicodeDecodeError, KeyError) as exc:
         raise UnsafeModelError(f"not a readable model zip: {exc}") from None
@@ -161,8 +428,10 @@ def load_sb3_model(
     UnsafeModelError
         (a ``ValueError``) naming the file: an entry that would have to be unpickled and
         that is not one of the known ones, a space that is not Homing-v0's, a schedule
-        that is not constant, unexpected zip entries, or sizes beyond
-        :data:`MAX_ENTRY_BYTES` / :data:`MAX_MODEL_BYTES`.
+        that is not constant, a plain field out of its bounds (:data:`PLAIN_FIELDS`), a
+        network that does not match its weights or is larger than :data:`MAX_LAYERS` x
+        :data:`MAX_LAYER_WIDTH`, unexpected zip entries, or sizes beyond
+        :data:`MAX_DATA_BYTES` / :data:`MAX_ENTRY_BYTES` / :data:`MAX_MODEL_BYTES`.
     """
     if algo not in ("ppo", "sac"):
         raise ValueError(f"algo must be 'ppo' or 'sac', got {algo!r}")
@@ -183,6 +452,7 @@ def load_sb3_model(
                 if key not in handlers:
                     raise UnsafeModelError(f"{key!r} would have to be unpickled")
                 custom[key] = handlers[key](entry, key)
+        plain = _plain_data(algo, data, p)
     except UnsafeModelError as exc:
         raise UnsafeModelError(f"{p}: {exc}; not loaded") from None
-    return cls.load(p, env=env, device=device, custom_objects=custom)
+    return cls.load(_sanitised_zip(p, plain), env=env, device=device, custom_objects=custom)

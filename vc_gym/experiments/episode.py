@@ -209,6 +209,7 @@ def make_homing_run(
     keep_image: bool = False,
     mode: str = "paper",
     policy: dict[str, Any] | None = None,
+    allow_imports: bool = False,
 ) -> HomingRun:
     """The homing task with the paper's 5 s stop rule, and an agent to run it.
 
@@ -239,6 +240,9 @@ def make_homing_run(
     policy : dict, optional
         More keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`,
         over those of the mode (scripted agent only).
+    allow_imports : bool
+        Let a learned agent's ``config.json`` name its tracker by import path (imports
+        that module; :class:`~vc_gym.agents.learned.LearnedHomingAgent`).
     """
     chosen = homing_mode(mode)
     policy_kwargs = {**chosen.policy, **(policy or {})}
@@ -258,7 +262,7 @@ def make_homing_run(
         env = CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
         scripted = ScriptedHomingPolicy.for_env(env, **policy_kwargs)
         return HomingRun(env, scripted.predict, scripted.reset)
-    learned = LearnedHomingAgent(agent)
+    learned = LearnedHomingAgent(agent, allow_imports)
     env = learned.make_env(tracker=tracker, confirm_stop_m=LEARNED_CONFIRM_STOP_M, **task)
     return HomingRun(env, learned.predict, None)
 

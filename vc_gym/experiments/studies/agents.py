@@ -65,6 +65,7 @@ def run_agents(
     learn_time_s: float | None = None,
     max_homing_s: float | None = None,
     mode: str = "paper",
+    allow_imports: bool = False,
 ) -> dict[str, Any]:
     """Run the homing experiment for every agent on the same kidnappings.
 
@@ -78,7 +79,7 @@ def run_agents(
     agent : str or sequence of str
         ``"scripted"`` and learned agents (``"pretrained"`` or ``DIR/model.zip``),
         comma-separated or a list. A learned agent's label is its folder's name.
-    tracker, seeds, episodes, learn_time_s, max_homing_s, mode
+    tracker, seeds, episodes, learn_time_s, max_homing_s, mode, allow_imports
         As :func:`~vc_gym.experiments.studies.homing.run_homing` (the learned agents
         run with the ``mode``'s learning; only the scripted agent has a homing policy
         mode).
@@ -111,6 +112,7 @@ def run_agents(
             max_homing_s=max_homing_s,
             field=False,
             mode=mode,
+            allow_imports=allow_imports,
         )
         atlas_dir = sub / "atlases"  # every later agent homes in the places learned here
         per_agent[labels[i]] = results

@@ -47,7 +47,7 @@ from vc_gym.experiments.studies.common import (
 from vc_gym.experiments.video import write_episode_video
 from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
 from vc_gym.localization import make_tracker
-from vc_gym.validation import positive_float
+from vc_gym.validation import flag, positive_float
 
 __all__ = [
     "PAPER_MEAN_CM",
@@ -127,6 +127,7 @@ def _run_for(kwargs: Mapping[str, Any]):
         policy=None
         if kwargs.get("home_offset_m") is None
         else {"home_offset_m": tuple(kwargs["home_offset_m"])},
+        allow_imports=kwargs.get("allow_imports", False),
     )
     if atlas:
         run.env.reset(seed=kwargs["learning_seed"])  # loads the saved atlas
@@ -147,6 +148,7 @@ def episode_job(
     mode: str = "paper",
     magnetometer: bool = False,
     home_offset_m: list[float] | None = None,
+    allow_imports: bool = False,
 ) -> dict[str, Any]:
     """Job: one kidnapping (seed ``episode_seed``) with the saved ``atlas``.
 
@@ -155,8 +157,9 @@ def episode_job(
     a saved atlas brings its own learning). With ``magnetometer`` the grid tracker's
     heading sensor is a magnetometer in the robot's head (the disturbance field of
     :meth:`NoisyMagneticCompass.random_field` seeded by the learning seed, its noise by
-    the episode's). ``home_offset_m``: the scripted agent's goal correction. Returns the
-    episode's figures.
+    the episode's). ``home_offset_m``: the scripted agent's goal correction.
+    ``allow_imports``: a learned agent's ``config.json`` may name an import path. Returns
+    the episode's figures.
     """
     kwargs = dict(locals())
     cache_key = json.dumps(
@@ -269,6 +272,7 @@ def run_homing(
     mode: str = "paper",
     sensor: str | None = None,
     home_offset_m: Sequence[float] | None = None,
+    allow_imports: bool = False,
 ) -> dict[str, Any]:
     """Run the homing experiment and write ``results.json``, ``run.json`` and plots.
 
@@ -313,6 +317,9 @@ def run_homing(
         The scripted agent's goal relative to the tracker's home (world frame, m;
         ``ScriptedHomingPolicy(home_offset_m)``), e.g. a learned agent's measured one,
         to see what that goal alone is worth. A learned agent brings its own.
+    allow_imports : bool
+        Let a learned agent's ``config.json`` name its tracker by import path (imports
+        that module): the command line's ``--allow-imports``, only for files you trust.
 
     Returns
     -------
@@ -350,9 +357,11 @@ def run_homing(
         home_offset_m = list(home_offset(home_offset_m))
     if agent == "pretrained":
         agent = str(PRETRAINED_MODEL)
+    flag("allow_imports", allow_imports)
     if agent != "scripted":
         agent = str(Path(agent).resolve())
-        learned = LearnedHomingAgent(agent)  # a bad model fails here, not in a worker
+        # a bad model fails here, not in a worker
+        learned = LearnedHomingAgent(agent, allow_imports)
         learned.check_env()  # and so does a config.json the env refuses
         scene = learned.scene
     else:
@@ -411,6 +420,7 @@ def run_homing(
                 **({"mode": mode} if mode != "paper" else {}),
                 **({"magnetometer": True} if sensor == MAGNETIC else {}),
                 **({"home_offset_m": home_offset_m} if home_offset_m is not None else {}),
+                **({"allow_imports": True} if allow_imports and agent != "scripted" else {}),
             }
             if n < opts.video:
                 kwargs["video"] = str((videos / f"seed{s}-episode{i:03d}.mp4").resolve())
