@@ -3,14 +3,23 @@
 from __future__ import annotations
 
 import io
+import struct
+import time
 import zipfile
+import zlib
 
 import numpy as np
 import pytest
 
 from vc_gym.compass import VisualCompass
 from vc_gym.errors import MapFileError
-from vc_gym.persistence import load_npz_checked, save_npz_atomic
+from vc_gym.persistence import (
+    MAX_ENTRY_BYTES,
+    MAX_MEMBERS,
+    NPY_HEADER_BYTES,
+    load_npz_checked,
+    save_npz_atomic,
+)
 
 SCHEMA, VERSION = "vc_gym.Test", 1
 
@@ -180,3 +189,107 @@ def test_saved_files_get_the_permissions_of_the_umask(tmp_path, umask, expected)
     finally:
         os.umask(old)
     assert stat.S_IMODE(path.stat().st_mode) == expected
+
+
+# ------------------------------------------------------------------ how many entries
+def _stored_zip(path, n: int, data: bytes, declared: int | None = None):
+    """A zip of ``n`` stored entries holding ``data`` each, written directly (zipfile
+    takes seconds for 10^5 entries); its end record declares ``declared`` entries
+    (default ``n``), with zip64 end records when that does not fit in 16 bits."""
+    crc = zlib.crc32(data)
+    local, central, offset = [], [], 0
+    for i in range(n):
+        name = f"e{i:06d}.npy".encode()
+        head = struct.pack(
+            "<4s5H3L2H", b"PK\x03\x04", 20, 0, 0, 0, 0, crc, len(data), len(data), len(name), 0
+        )
+        local.append(head + name + data)
+        central.append(
+            struct.pack(
+                "<4s6H3L5H2L",
+                b"PK\x01\x02",
+                20,
+                20,
+                0,
+                0,
+                0,
+                0,
+                crc,
+                len(data),
+                len(data),
+                len(name),
+                0,
+                0,
+                0,
+                0,
+                0,
+                offset,
+            )
+            + name
+        )
+        offset += len(head) + len(name) + len(data)
+    directory = b"".join(central)
+    count = n if declared is None else declared
+    tail = b""
+    if count >= 0xFFFF:
+        end64 = offset + len(directory)
+        tail += struct.pack(
+            "<4sQ2H2L4Q", b"PK\x06\x06", 44, 45, 45, 0, 0, count, count, len(directory), offset
+        )
+        tail += struct.pack("<4sLQL", b"PK\x06\x07", 0, end64, 1)
+        count = 0xFFFF
+    tail += struct.pack("<4s4H2LH", b"PK\x05\x06", 0, 0, count, count, len(directory), offset, 0)
+    path.write_bytes(b"".join(local) + directory + tail)
+    return path
+
+
+def test_the_entry_writer_makes_readable_zips(tmp_path):
+    path = _stored_zip(tmp_path / "three.npz", 3, _npy(np.zeros(2)))
+    with zipfile.ZipFile(path) as zf:
+        assert [zf.read(i) for i in zf.infolist()] == [_npy(np.zeros(2))] * 3
+
+
+def test_a_file_of_a_hundred_thousand_entries_is_refused_at_once(tmp_path):
+    # 10^5 valid tiny arrays, within every byte limit: reading each would take seconds
+    path = _stored_zip(tmp_path / "many.npz", 10**5, _npy(np.zeros(1)))
+    start = time.perf_counter()
+    message = f"many.npz: it holds 100000 entries, more than {MAX_MEMBERS}"
+    with pytest.raises(MapFileError, match=message):
+        load_npz_checked(path, SCHEMA, VERSION)
+    assert time.perf_counter() - start < 5.0  # refused from the end record: ~1 ms
+
+
+def test_a_directory_larger_than_its_declared_count_is_refused(tmp_path):
+    # the end record says 3 entries; parsing the 10^5 records would cost the time
+    path = _stored_zip(tmp_path / "liar.npz", 10**5, _npy(np.zeros(1)), declared=3)
+    start = time.perf_counter()
+    with pytest.raises(MapFileError, match="liar.npz: its directory takes"):
+        load_npz_checked(path, SCHEMA, VERSION)
+    assert time.perf_counter() - start < 5.0
+
+
+def test_more_entries_than_declared_are_counted_after_parsing(tmp_path):
+    # a directory small enough to parse quickly, holding more entries than it declares
+    n = MAX_MEMBERS + 100
+    path = _stored_zip(tmp_path / "liar.npz", n, b"", declared=3)
+    with pytest.raises(MapFileError, match=f"liar.npz: it holds {n} entries"):
+        load_npz_checked(path, SCHEMA, VERSION)
+
+
+def test_a_file_within_the_entry_count_loads(tmp_path):
+    arrays = {f"a{i}": np.full(2, i) for i in range(100)}
+    path = save_npz_atomic(tmp_path / "hundred.npz", SCHEMA, VERSION, arrays)
+    got = load_npz_checked(path, SCHEMA, VERSION, max_members=102)
+    assert sorted(got) == sorted(arrays)
+    with pytest.raises(MapFileError, match="102 entries, more than 101"):
+        load_npz_checked(path, SCHEMA, VERSION, max_members=101)
+
+
+def test_an_entry_of_the_largest_array_loads(tmp_path):
+    # the largest map's counts: 2^24 uint32, 64 MiB of data plus the .npy header; the
+    # entry limit leaves room for the header
+    counts = np.zeros(2**24, dtype=np.uint32)
+    counts[::4096] = 7
+    path = save_npz_atomic(tmp_path / "big.npz", SCHEMA, VERSION, {"counts": counts})
+    np.testing.assert_array_equal(load_npz_checked(path, SCHEMA, VERSION)["counts"], counts)
+    assert MAX_ENTRY_BYTES - counts.nbytes == NPY_HEADER_BYTES

@@ -10,23 +10,29 @@ from __future__ import annotations
 
 import json
 import os
+import struct
 import tempfile
 import zipfile
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 
 from vc_gym.errors import MapFileError
 
 __all__ = [
+    "MAX_ARRAY_BYTES",
     "MAX_ENTRY_BYTES",
+    "MAX_MEMBERS",
     "MAX_TOTAL_BYTES",
+    "NPY_HEADER_BYTES",
     "json_array",
     "load_npz_checked",
     "read_json_array",
     "save_npz_atomic",
     "write_atomic",
+    "zip_directory_problem",
     "zip_entries_problem",
 ]
 
@@ -139,11 +145,28 @@ def save_npz_atomic(
     return write_atomic(path, write)
 
 
-#: Largest array entry a checked ``.npz`` may hold, uncompressed (the largest map entry,
-#: a 32-class compass's counts, is about 10 MB).
-MAX_ENTRY_BYTES = 64 * 2**20
+#: Largest array data one entry of a checked ``.npz`` may hold, uncompressed: 64 MiB,
+#: the counts of the largest compass map (:data:`vc_gym.compass.config.MAX_MAP_ENTRIES`
+#: is derived from it, so every map the compass saves can be read back).
+MAX_ARRAY_BYTES = 64 * 2**20
+#: Room for an entry's ``.npy`` header on top of its array data (format 1.0 pads the
+#: header to a multiple of 64 bytes; a vc_gym array's header takes 128).
+NPY_HEADER_BYTES = 4096
+#: Largest entry (header and array data), uncompressed.
+MAX_ENTRY_BYTES = MAX_ARRAY_BYTES + NPY_HEADER_BYTES
 #: Largest sum of its entries, uncompressed.
 MAX_TOTAL_BYTES = 256 * 2**20
+#: Most entries a checked ``.npz`` may hold. Each costs a directory record and a read
+#: (about 0.1 ms even when tiny), so a file of millions of entries, which the byte
+#: limits allow, would take minutes to refuse. The largest vc_gym file is an atlas of
+#: :data:`vc_gym.compass.atlas.MAX_SPOTS` (1024) spots that each keep their own colour
+#: classes: 14 entries a spot and 5 of its own, 14,341 in all; a compass map holds at
+#: most 16 entries, a baseline sensor file fewer than 10.
+MAX_MEMBERS = 2**14
+#: Bytes of zip directory allowed per entry, to bound the time spent parsing the
+#: directory before its entries are counted: a record is 46 bytes, the entry's name
+#: (under 40 characters in vc_gym files) and at most a 28-byte zip64 extra field.
+_DIRECTORY_BYTES_PER_MEMBER = 256
 #: Array kinds a vc_gym file holds: bool, integers, reals and text.
 _KINDS = "biufU"
 
@@ -154,21 +177,25 @@ def load_npz_checked(
     version: int,
     max_entry_bytes: int = MAX_ENTRY_BYTES,
     max_total_bytes: int = MAX_TOTAL_BYTES,
+    max_members: int = MAX_MEMBERS,
 ) -> dict[str, np.ndarray]:
     """Load every array of an ``.npz`` written by :func:`save_npz_atomic`, safely.
 
-    Nothing is decompressed before it is checked: every zip entry must be a ``.npy``
-    array whose sizes (the zip's and the one its header declares) agree and stay within
+    Nothing is decompressed before it is checked: the zip may hold at most
+    ``max_members`` entries (counted from its end record before the directory is
+    parsed, and again after), and every entry must be a ``.npy`` array whose sizes
+    (the zip's and the one its header declares) agree and stay within
     ``max_entry_bytes`` (all entries together within ``max_total_bytes``), of a plain
     kind (bool, integer, real, text: never objects, so nothing is unpickled) and
-    named once. A hostile file therefore cannot run code or exhaust memory.
+    named once. A hostile file therefore cannot run code, exhaust memory or take long
+    to refuse.
 
     Raises
     ------
     MapFileError
-        If the file is missing, empty, truncated, corrupt or not a zip, holds an entry
-        that is not a plain array or is too large, has no or another schema, or a
-        schema version that is not this integer.
+        If the file is missing, empty, truncated, corrupt or not a zip, holds too many
+        entries, an entry that is not a plain array or is too large, has no or another
+        schema, or a schema version that is not this integer.
     """
     path = Path(path)
     if not path.is_file():
@@ -176,7 +203,7 @@ def load_npz_checked(
     if path.stat().st_size == 0:
         raise MapFileError(f"{path}: file is empty")
     try:
-        arrays = _read_entries(path, max_entry_bytes, max_total_bytes)
+        arrays = _read_entries(path, max_entry_bytes, max_total_bytes, max_members)
     except MapFileError:
         raise
     except Exception as e:  # noqa: BLE001 - a hostile file finds every kind: zlib.error,
@@ -201,13 +228,19 @@ def load_npz_checked(
 
 
 def zip_entries_problem(
-    infos: Sequence[zipfile.ZipInfo], max_entry: int, max_total: int
+    infos: Sequence[zipfile.ZipInfo],
+    max_entry: int,
+    max_total: int,
+    max_members: int | None = None,
 ) -> str | None:
     """What makes a zip unsafe to open, judged from its directory alone (nothing is
-    decompressed): a repeated entry name (a second entry hiding behind the first), an
-    entry larger than ``max_entry`` bytes or more than ``max_total`` in all. ``None``
-    if there is nothing; maps (:func:`load_npz_checked`) and models
-    (:mod:`vc_gym.agents.safe_load`) are both checked with it."""
+    decompressed): more than ``max_members`` entries (when given), a repeated entry
+    name (a second entry hiding behind the first), an entry larger than ``max_entry``
+    bytes or more than ``max_total`` in all. ``None`` if there is nothing; maps
+    (:func:`load_npz_checked`) and models (:mod:`vc_gym.agents.safe_load`) are both
+    checked with it."""
+    if max_members is not None and len(infos) > max_members:
+        return f"it holds {len(infos)} entries, more than {max_members}"
     seen: set[str] = set()
     for info in infos:
         if info.filename in seen:
@@ -221,12 +254,63 @@ def zip_entries_problem(
     return None
 
 
-def _read_entries(path: Path, max_entry: int, max_total: int) -> dict[str, np.ndarray]:
+#: The zip end records :func:`zip_directory_problem` reads the entry count and the
+#: directory size from.
+_EOCD = struct.Struct("<4s4H2LH")  # end of central directory, 22 bytes
+_EOCD64_LOCATOR = struct.Struct("<4sLQL")  # zip64 end record locator, 20 bytes
+_EOCD64 = struct.Struct("<4sQ2H2L4Q")  # zip64 end of central directory, 56 bytes
+#: Longest zip comment: the end record lies within this many bytes of the file's end.
+_MAX_ZIP_COMMENT = 65535
+
+
+def zip_directory_problem(fh: BinaryIO, max_members: int) -> str | None:
+    """What the end record of the zip open as ``fh`` says that makes it unsafe to
+    parse: more than ``max_members`` entries, or a directory larger than
+    ``max_members`` records of a few hundred bytes (which a lying entry count would
+    hide). Only the last 64 KiB of the file are read. ``None`` if there is nothing or
+    no end record is found (:class:`zipfile.ZipFile` then reports the damage)."""
+    fh.seek(0, os.SEEK_END)
+    size = fh.tell()
+    start = max(0, size - _EOCD.size - _MAX_ZIP_COMMENT)
+    fh.seek(start)
+    tail = fh.read()
+    pos = tail.rfind(b"PK\x05\x06")
+    if pos < 0 or len(tail) - pos < _EOCD.size:
+        return None
+    _, _, _, _, members, directory, _, _ = _EOCD.unpack_from(tail, pos)
+    if members == 0xFFFF or directory == 0xFFFFFFFF:
+        # zip64: the real figures are in the record just before its locator
+        at = start + pos - _EOCD64_LOCATOR.size - _EOCD64.size
+        if at >= 0:
+            fh.seek(at)
+            record = fh.read(_EOCD64.size + _EOCD64_LOCATOR.size)
+            if record[_EOCD64.size :].startswith(b"PK\x06\x07") and record.startswith(
+                b"PK\x06\x06"
+            ):
+                fields = _EOCD64.unpack_from(record)
+                members, directory = fields[7], fields[8]
+    if members > max_members:
+        return f"it holds {members} entries, more than {max_members}"
+    if directory > max_members * _DIRECTORY_BYTES_PER_MEMBER:
+        return (
+            f"its directory takes {directory} bytes, more than {max_members} entries need "
+            f"({_DIRECTORY_BYTES_PER_MEMBER} bytes each)"
+        )
+    return None
+
+
+def _read_entries(
+    path: Path, max_entry: int, max_total: int, max_members: int
+) -> dict[str, np.ndarray]:
     """The arrays of the zip at ``path``, each checked before it is decompressed."""
     arrays: dict[str, np.ndarray] = {}
+    with open(path, "rb") as fh:
+        problem = zip_directory_problem(fh, max_members)
+    if problem is not None:
+        raise MapFileError(f"{path}: {problem}")
     with zipfile.ZipFile(path) as zf:
         infos = zf.infolist()
-        problem = zip_entries_problem(infos, max_entry, max_total)
+        problem = zip_entries_problem(infos, max_entry, max_total, max_members)
         if problem is not None:
             raise MapFileError(f"{path}: {problem}")
         for info in infos:

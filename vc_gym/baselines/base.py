@@ -221,16 +221,21 @@ class BaselineCompass(ABC):
         ------
         MapFileError
             Naming the file: missing, corrupt, another schema or version, a bad config
-            or arrays that do not fit it.
+            (one the constructor refuses, or whose map cannot be allocated) or arrays
+            that do not fit it.
         """
         arrays = load_npz_checked(path, cls.schema, cls.schema_version)
         config = read_json_array(arrays, "config", path) if "config" in arrays else None
         if not isinstance(config, dict):
             raise MapFileError(f"{path}: no config object")
         try:
+            # the constructor validates the saved config as it would a typed one
             obj = cls(**config)
         except (TypeError, ValueError) as e:
             raise MapFileError(f"{path}: bad config ({e})") from None
+        except MemoryError:
+            # a config whose arrays cannot even be allocated is the file's fault
+            raise MapFileError(f"{path}: bad config (its map does not fit in memory)") from None
         frames = arrays.get("frames_learned")
         if frames is None or frames.ndim != 0 or frames.dtype.kind not in "iu" or int(frames) < 1:
             raise MapFileError(f"{path}: frames_learned must be an integer >= 1")

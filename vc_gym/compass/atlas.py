@@ -18,6 +18,7 @@ import numpy as np
 
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
+from vc_gym.compass.config import MAX_MAP_BYTES, CompassConfig
 from vc_gym.compass.visual_compass import (
     CompassEstimate,
     VisualCompass,
@@ -27,14 +28,38 @@ from vc_gym.compass.visual_compass import (
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.exposure import SessionLight
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
-from vc_gym.validation import positive_float
+from vc_gym.validation import MAX_ABS_METRES, finite_real
 
-__all__ = ["CompassAtlas", "AtlasEstimate"]
+__all__ = [
+    "CompassAtlas",
+    "AtlasEstimate",
+    "MAX_ATLAS_BYTES",
+    "MAX_KERNEL_DEG",
+    "MAX_SHARPNESS",
+    "MAX_SPOTS",
+    "MIN_KERNEL_DEG",
+    "MIN_SHARPNESS",
+]
 
 ATLAS_SCHEMA = "vc_gym.CompassAtlas"
 ATLAS_SCHEMA_VERSION = 1
-#: Most spots an atlas file may declare (a guard against a hostile header).
-_MAX_SPOTS = 1024
+#: Most spots an atlas may hold (a guard against a hostile header; an atlas file of
+#: this many spots stays within :data:`vc_gym.persistence.MAX_MEMBERS` entries).
+MAX_SPOTS = 1024
+#: Most memory loading an atlas and scoring one frame with all its maps may take, as
+#: :meth:`CompassConfig.memory_bytes` reckons it for the atlas' spots (two single maps'
+#: worth, 1 GiB): every map's tables are kept, so a file of a megabyte (24 maps of
+#: 32 classes and bins) could otherwise claim two gigabytes.
+MAX_ATLAS_BYTES = 2 * MAX_MAP_BYTES
+#: Range of :attr:`CompassAtlas.sharpness`: below 0.01 every spot weighs the same
+#: (eq. 30 returns the centroid whatever the image), far above 10,000 the weights
+#: of spots a hundredth apart in goodness overflow.
+MIN_SHARPNESS = 0.01
+MAX_SHARPNESS = 1e4
+#: Range of the home normalisation's kernel width (degrees): finer than the finest
+#: heading grid, its concentration overflows.
+MIN_KERNEL_DEG = 0.01
+MAX_KERNEL_DEG = 360.0
 
 
 @dataclass(frozen=True)
@@ -76,9 +101,10 @@ class CompassAtlas:
         World position of home. Defaults to the named spot's position, or to the
         centroid of the spots when ``home`` is not a spot.
     sharpness : float
-        Exponent applied to the goodness before weighting. Larger values make the
-        position estimate snap to the best-fitting spot, smaller ones pull it to the
-        centroid. The default 30 was measured on a synthetic 7 m room at the paper's
+        Exponent applied to the goodness before weighting, in
+        ``[MIN_SHARPNESS, MAX_SHARPNESS]``. Larger values make the position estimate
+        snap to the best-fitting spot, smaller ones pull it to the centroid. The
+        default 30 was measured on a synthetic 7 m room at the paper's
         config with spots 1 m from home: a frame 1 m from home is then placed about
         0.7 m from home in the right direction (``tests/compass/test_atlas.py``).
 
@@ -110,8 +136,11 @@ class CompassAtlas:
                 raise ValueError(
                     f"spot {name!r} must be ((x, y), VisualCompass), got {entry!r}"
                 ) from None
-            if not (math.isfinite(x) and math.isfinite(y)):
-                raise ValueError(f"spot {name!r} position must be finite, got {(x, y)}")
+            if not (math.isfinite(x) and math.isfinite(y)) or max(abs(x), abs(y)) > MAX_ABS_METRES:
+                raise ValueError(
+                    f"spot {name!r} position must be finite and within ±{MAX_ABS_METRES:g} m, "
+                    f"got {(x, y)}"
+                )
             if not isinstance(vc, VisualCompass):
                 raise ValueError(f"spot {name!r} needs a VisualCompass, got {type(vc).__name__}")
             names.append(str(name))
@@ -120,6 +149,9 @@ class CompassAtlas:
         configs = {vc.config for vc in compasses}
         if len(configs) > 1:
             raise ValueError("all compasses of an atlas must share one CompassConfig")
+        _check_atlas_size(
+            compasses[0].config, len(compasses), len({id(vc.colors) for vc in compasses})
+        )
         self.names = tuple(names)
         self.positions = np.array(positions, dtype=np.float64)
         self.compasses = tuple(compasses)
@@ -130,10 +162,18 @@ class CompassAtlas:
             else:
                 home_position = tuple(self.positions.mean(axis=0))
         hx, hy = (float(v) for v in home_position)
-        if not (math.isfinite(hx) and math.isfinite(hy)):
-            raise ValueError(f"home_position must be finite, got {home_position}")
+        if not (math.isfinite(hx) and math.isfinite(hy)) or max(abs(hx), abs(hy)) > MAX_ABS_METRES:
+            raise ValueError(
+                f"home_position must be finite and within ±{MAX_ABS_METRES:g} m, "
+                f"got {home_position}"
+            )
         self.home_position = (hx, hy)
-        self.sharpness = positive_float("sharpness", sharpness)
+        sharp = finite_real("sharpness", sharpness)
+        if not MIN_SHARPNESS <= sharp <= MAX_SHARPNESS:
+            raise ValueError(
+                f"sharpness must be in [{MIN_SHARPNESS:g}, {MAX_SHARPNESS:g}], got {sharpness!r}"
+            )
+        self.sharpness = sharp
         self._home_scores = np.zeros((0, len(names)))
         self._home_headings = np.zeros((0, len(names)))
         self._kappa = 1.0
@@ -244,7 +284,8 @@ class CompassAtlas:
             Frames taken at the home spot (with ``exposure="session"`` one session,
             scored at its :class:`~vc_gym.exposure.SessionLight`).
         kernel_deg : float
-            Angular width of the interpolation between home frames.
+            Angular width of the interpolation between home frames, in
+            ``[MIN_KERNEL_DEG, MAX_KERNEL_DEG]``.
 
         Returns
         -------
@@ -260,8 +301,11 @@ class CompassAtlas:
                 f"normalize needs as many cameras as images (>0), got {len(images)} images "
                 f"and {len(cameras)} cameras"
             )
-        if not (math.isfinite(kernel_deg) and 0 < kernel_deg <= 360):
-            raise ValueError(f"kernel_deg must be in (0, 360], got {kernel_deg}")
+        kernel = finite_real("kernel_deg", kernel_deg)
+        if not MIN_KERNEL_DEG <= kernel <= MAX_KERNEL_DEG:
+            raise ValueError(
+                f"kernel_deg must be in [{MIN_KERNEL_DEG:g}, {MAX_KERNEL_DEG:g}], got {kernel_deg}"
+            )
         gain = None
         if self.compasses[0].config.exposure == "session":  # the home frames: one session
             pairs = zip(images, cameras, strict=True)
@@ -273,7 +317,7 @@ class CompassAtlas:
             headings.append([e.heading_deg for e in ests])
         self._home_scores = np.array(scores)  # (frames, spots)
         self._home_headings = np.array(headings)
-        self._kappa = 1.0 / math.radians(kernel_deg) ** 2
+        self._kappa = _kappa_of(kernel)
         self.is_normalized = True
         return self._home_scores.mean(axis=0)
 
@@ -404,10 +448,25 @@ class CompassAtlas:
             metadata = header["metadata"]
         except (KeyError, TypeError, ValueError) as e:
             raise MapFileError(f"{path}: invalid atlas header ({type(e).__name__}: {e})") from None
-        if not 1 <= len(names) <= _MAX_SPOTS or len(positions) != len(names):
-            raise MapFileError(f"{path}: header declares {len(names)} spots / positions")
+        if not 1 <= len(names) <= MAX_SPOTS or len(positions) != len(names):
+            raise MapFileError(
+                f"{path}: header declares {len(names)} spots and {len(positions)} positions "
+                f"(1 to {MAX_SPOTS} spots, one position each)"
+            )
+        if len(set(names)) != len(names):
+            raise MapFileError(f"{path}: header repeats a spot name")
         if not isinstance(normalized, bool) or not isinstance(shared, bool):
             raise MapFileError(f"{path}: is_normalized and shared_colors must be booleans")
+        # one config for every spot, and the memory its maps will claim, before any map
+        # is built (CompassAtlas checks both again with the compasses it is given)
+        raws = [read_json_array(arrays, f"spot{i}/config", path) for i in range(len(names))]
+        if any(r != raws[0] for r in raws):
+            raise MapFileError(f"{path}: the spots' maps do not share one config")
+        try:
+            config = CompassConfig.from_dict(raws[0])  # type: ignore[arg-type]
+            _check_atlas_size(config, len(names), 1 if shared else len(names))
+        except (TypeError, ValueError) as e:
+            raise MapFileError(f"{path}: invalid config ({e})") from None
         if not isinstance(metadata, dict):
             raise MapFileError(f"{path}: metadata must be a JSON object")
         colors = None
@@ -435,10 +494,35 @@ class CompassAtlas:
                 raise MapFileError(f"{path}: entry {key!r} is not finite")
         if scores.shape != headings.shape or (normalized and scores.shape[0] == 0):
             raise MapFileError(f"{path}: home normalisation entries do not match")
-        if not (math.isfinite(kappa) and kappa > 0):
-            raise MapFileError(f"{path}: invalid kernel concentration {kappa}")
+        lo, hi = _kappa_of(MAX_KERNEL_DEG), _kappa_of(MIN_KERNEL_DEG)
+        if not (math.isfinite(kappa) and lo <= kappa <= hi):
+            raise MapFileError(
+                f"{path}: kernel concentration kappa={kappa} is outside [{lo:.4g}, {hi:.4g}] "
+                f"(kernel widths {MIN_KERNEL_DEG:g}-{MAX_KERNEL_DEG:g}°)"
+            )
         atlas._home_scores = scores.astype(np.float64)
         atlas._home_headings = headings.astype(np.float64)
         atlas._kappa = kappa
         atlas.is_normalized = normalized
         return atlas, metadata
+
+
+def _kappa_of(kernel_deg: float) -> float:
+    """Concentration of the home normalisation's von Mises kernel of width ``kernel_deg``."""
+    return 1.0 / math.radians(kernel_deg) ** 2
+
+
+def _check_atlas_size(config: CompassConfig, n_spots: int, n_color_sets: int) -> None:
+    """A ``ValueError`` unless ``n_spots`` maps of ``config`` with ``n_color_sets``
+    colour lookup tables fit in :data:`MAX_ATLAS_BYTES` (:meth:`CompassConfig.memory_bytes`
+    reckons with one table) and there are at most :data:`MAX_SPOTS` of them."""
+    if n_spots > MAX_SPOTS:
+        raise ValueError(f"an atlas holds at most {MAX_SPOTS} spots, got {n_spots}")
+    tables = (n_color_sets - 1) * 2 ** (3 * config.lut_bits)
+    need = config.memory_bytes(n_maps=n_spots) + tables
+    if need > MAX_ATLAS_BYTES:
+        raise ValueError(
+            f"{n_spots} maps of this config would need about {need / 2**20:.0f} MiB to load "
+            f"and score one frame, more than MAX_ATLAS_BYTES = {MAX_ATLAS_BYTES / 2**20:.0f} "
+            "MiB: use fewer spots or a smaller CompassConfig"
+        )

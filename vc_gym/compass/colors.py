@@ -21,11 +21,27 @@ import numpy as np
 
 from vc_gym.images import check_image
 
-__all__ = ["ColorClasses"]
+__all__ = ["ColorClasses", "MAX_COLOR_VARIANCE", "MAX_LIGHT_LEVEL", "MIN_COLOR_VARIANCE"]
 
 #: Added to every covariance (in ``(0..255)**2`` units) so that flat image regions do not
 #: give singular covariances.
 _COV_REG = 1.0
+#: Smallest pivot of a class covariance's Cholesky factor (its variance along each axis
+#: given the ones before, ``(0..255)**2`` units). Fitted classes have at least
+#: ``_COV_REG``; far below, the closed-form inverse overflows and the lookup table
+#: comes out of NaNs.
+MIN_COLOR_VARIANCE = 1e-3
+#: Largest variance of a class along a channel: a standard deviation of the whole
+#: colour range (fitted classes stay below ``127.5**2 + _COV_REG``).
+MAX_COLOR_VARIANCE = 255.0**2
+#: Range of a class mean, per channel: the colour range of a ``uint8`` image (a mean
+#: outside it only takes colours away from the other classes), give or take rounding
+#: (a fitted mean is a weighted average of pixel values).
+_COLOR_RANGE = (0.0, 255.0)
+_COLOR_RANGE_SLACK = 1e-6
+#: Largest mean linear light level (:func:`vc_gym.exposure.mean_linear_level`, 1 for a
+#: white frame), give or take the rounding of a float32 mean.
+MAX_LIGHT_LEVEL = 1.0 + 1e-6
 #: Smallest weight a mixture component keeps; a component that loses all its samples is
 #: kept with (about) this weight instead of producing a zero or NaN.
 _MIN_WEIGHT = 1e-12
@@ -284,9 +300,11 @@ class ColorClasses:
     Parameters
     ----------
     means : array_like, shape (c, 3)
-        Component means, RGB in ``0..255``; ``1 <= c <= 255``.
+        Component means, RGB in ``[0, 255]``; ``1 <= c <= 255``.
     covariances : array_like, shape (c, 3, 3)
-        Symmetric positive-definite component covariances (``(0..255)**2`` units).
+        Symmetric positive-definite component covariances (``(0..255)**2`` units):
+        variances at most :data:`MAX_COLOR_VARIANCE`, Cholesky pivots at least
+        :data:`MIN_COLOR_VARIANCE`.
     weights : array_like, shape (c,)
         Non-negative mixture weights summing to 1 (renormalised exactly).
     bits : int
@@ -341,6 +359,12 @@ class ColorClasses:
         c = mu.shape[0]
         if not 1 <= c <= 255:
             raise ValueError(f"{prefix}means must have 1..255 rows (classes), got {c}")
+        lo, hi = _COLOR_RANGE
+        if np.any(mu < lo - _COLOR_RANGE_SLACK) or np.any(mu > hi + _COLOR_RANGE_SLACK):
+            raise ValueError(
+                f"{prefix}means must lie in the colour range [{lo:g}, {hi:g}], got values "
+                f"{mu.min():g}..{mu.max():g}"
+            )
         cov = _real_array(prefix + "covariances", covariances, (c, 3, 3))
         scale = max(1.0, float(np.abs(cov).max()))
         if not np.allclose(cov, cov.transpose(0, 2, 1), rtol=1e-9, atol=1e-9 * scale):
@@ -349,6 +373,18 @@ class ColorClasses:
         chol = _cholesky3(cov)
         if chol is None:
             raise ValueError(f"{prefix}covariances must be positive definite")
+        pivots = chol[:, [0, 1, 2], [0, 1, 2]] ** 2
+        if np.any(pivots < MIN_COLOR_VARIANCE):
+            raise ValueError(
+                f"{prefix}covariances must have Cholesky pivots >= {MIN_COLOR_VARIANCE:g} "
+                f"(nearly singular), got {pivots.min():g}"
+            )
+        variances = cov[:, [0, 1, 2], [0, 1, 2]]
+        if np.any(variances > MAX_COLOR_VARIANCE):
+            raise ValueError(
+                f"{prefix}covariances must have variances <= {MAX_COLOR_VARIANCE:g} "
+                f"(a standard deviation of the whole colour range), got {variances.max():g}"
+            )
         w = _real_array(prefix + "weights", weights, (c,))
         if np.any(w < 0):
             raise ValueError(f"{prefix}weights must be non-negative")
@@ -574,8 +610,9 @@ class ColorClasses:
         ref = arrays.get(_PREFIX + "exposure_reference")  # absent in older files
         if ref is not None:
             ref = _real_array(_PREFIX + "exposure_reference", ref, ())
-            if ref < 0:
-                raise ValueError(f"{_PREFIX}exposure_reference must be >= 0, got {float(ref)}")
+            if not 0 <= ref <= MAX_LIGHT_LEVEL:
+                # a mean linear light level: 0 (not fitted with exposure) to 1 (white)
+                raise ValueError(f"{_PREFIX}exposure_reference must be in [0, 1], got {float(ref)}")
             obj.exposure_reference = float(ref)
         return obj
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from vc_gym.angles import circular_std_rows, peak_headings
 from vc_gym.compass.camera import Camera
-from vc_gym.compass.colors import ColorClasses
+from vc_gym.compass.colors import MAX_LIGHT_LEVEL, ColorClasses
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.features import (
     NOISE_CHANGE_RATIO,
@@ -51,6 +51,10 @@ MAP_SCHEMA_VERSION = 1
 #: Pseudo-count per bin of the heading-independent (pooled) histogram.
 _POOL_PSEUDOCOUNT = 0.5
 _CACHE_SIZE = 16
+#: Most distinct frame sizes a map file may list: a map learns from one camera or a
+#: few; each listed size becomes a Python object when loaded (about 150 bytes), and an
+#: entry of 64 MiB could otherwise list 4 million of them.
+MAX_LEARNED_SIZES = 4096
 # Table rows gathered at once when scoring a frame against several maps: a few hundred
 # kilobytes stay in the cache; one gather of every row (16 MB for 24 maps) made the
 # scoring memory-bound and 1.6 times slower (measured, see _group_sums).
@@ -386,9 +390,16 @@ class VisualCompass:
         -------
         int
             Number of sectors updated (0 if nothing above the horizon is visible).
+
+        Raises
+        ------
+        ValueError
+            On an invalid image or camera, or a frame of a new size when the map has
+            learned :data:`MAX_LEARNED_SIZES` sizes (its file could not be loaded).
         """
         self._checked(image, camera, need_map=False)
         h, w = image.shape[:2]
+        _check_sizes(self._sizes | {(h, w)})
         geom = self._geometry(camera, w, h)
         pixels = image[geom.row_slice, geom.col_slice]
         colcounts = self._column_counts(self._scanned_classes(pixels))
@@ -430,7 +441,8 @@ class VisualCompass:
         Raises
         ------
         ValueError
-            If the configs or colour classes differ, or ``other`` is not a compass.
+            If the configs or colour classes differ, ``other`` is not a compass, or
+            together they learned frames of more than :data:`MAX_LEARNED_SIZES` sizes.
         """
         if not isinstance(other, VisualCompass):
             raise ValueError(f"can only merge a VisualCompass, got {type(other).__name__}")
@@ -438,6 +450,7 @@ class VisualCompass:
             raise ValueError("cannot merge maps learned with different CompassConfigs")
         if not self.shares_colors(other):
             raise ValueError("cannot merge maps learned with different colour classes")
+        _check_sizes(self._sizes | other._sizes)
         self._counts += other._counts
         self._n_obs += other._n_obs
         self._light.merge(other._light)
@@ -573,13 +586,18 @@ class VisualCompass:
         pooled = counts.sum(axis=0) + _POOL_PSEUDOCOUNT  # (c2, n)
         p_pool = pooled / pooled.sum(axis=1, keepdims=True)
         kappa = cfg.smoothing
-        p_sec = (counts + kappa * p_pool[None]) / (self._n_obs[:, None, None] + kappa)
-        log_abs = np.log(p_sec)
-        ratio = log_abs - np.log(p_pool)[None]
-        last = ratio[:, :, n - 1 : n]
+        # in place where the result replaces its input: a map-sized array costs
+        # 8 bytes per count, and at most two live beside the counts and delta_t
+        # (CompassConfig.memory_bytes)
+        log_abs = counts + kappa * p_pool[None]
+        log_abs /= self._n_obs[:, None, None] + kappa
+        np.log(log_abs, out=log_abs)
+        delta = log_abs - np.log(p_pool)[None]  # the log-ratio against the pooled model
+        last = delta[:, :, n - 1 : n].copy()
         base = last[:, :, 0].sum(axis=1)  # (S,)
-        delta = ratio - last  # (S, c2, n)
+        delta -= last  # (S, c2, n)
         delta_t = np.ascontiguousarray(delta.reshape(delta.shape[0], -1).T)  # (c2*n, S)
+        del delta
         self._tables = (delta_t, base, log_abs)
         return self._tables
 
@@ -641,13 +659,19 @@ class VisualCompass:
         )
         steps = quantized_stops(gains)
         ll = np.empty(steps.size)
-        features: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        # only the features of the best heading so far are kept (a frame has 5-15
+        # gains, each a (phases x sectors in view x pairs) array); the best is the
+        # first heading of the largest log-likelihood, as numpy.argmax finds it
+        best, best_at, best_features = 0, steps.size, None
         for k in np.unique(steps).tolist():
-            features[k] = self._features_of(pixels, geom, 2.0 ** (k * GAIN_STEP_STOPS))
-            at = steps == k
-            ll[at] = self._log_likelihood_of(geom, *features[k])[at]
-        best = int(steps[int(np.argmax(ll))])
-        return ll, (geom, *features[best]), best
+            features = self._features_of(pixels, geom, 2.0 ** (k * GAIN_STEP_STOPS))
+            at = np.flatnonzero(steps == k)
+            ll[at] = self._log_likelihood_of(geom, *features)[at]
+            first = int(at[np.argmax(ll[at])])
+            if best_features is None or (ll[first], -first) > (ll[best_at], -best_at):
+                best, best_at, best_features = k, first, features
+        assert best_features is not None
+        return ll, (geom, *best_features), best
 
     def log_likelihood(
         self, image: np.ndarray, camera: Camera, gain: float | None = None
@@ -922,12 +946,14 @@ class VisualCompass:
                     f"{path}: entry {key!r} has shape {a.shape} and dtype {a.dtype}, "
                     f"expected integer counts of shape {shape} for {stored}"
                 )
-        counts = arrays["counts"].astype(np.float64)
+        # checked as stored and copied straight into the compass' float64 map: a
+        # float64 copy of its own would add 8 bytes per count to the peak of loading
+        counts = arrays["counts"]
         n_obs = arrays["sector_observations"].astype(np.float64)
         if np.any(counts < 0) or np.any(n_obs < 0):
             raise MapFileError(f"{path}: negative counts")
         # every class pair of a sector gets exactly one count per frame that saw it
-        per_pair = counts.sum(axis=2)
+        per_pair = counts.sum(axis=2, dtype=np.float64)
         if not np.array_equal(per_pair, np.broadcast_to(n_obs[:, None], per_pair.shape)):
             raise MapFileError(f"{path}: counts do not add up to the sector observations")
         frames = int(arrays["frames_learned"])
@@ -939,9 +965,12 @@ class VisualCompass:
             or ref.shape != ()
             or ref.dtype.kind not in "iuf"
             or not np.isfinite(ref)
-            or ref < 0
+            or not 0 <= ref <= MAX_LIGHT_LEVEL
         ):
-            raise MapFileError(f"{path}: entry 'exposure_reference' missing or invalid")
+            # a mean linear light level: 0 (not fitted with exposure) to 1 (white)
+            raise MapFileError(
+                f"{path}: entry 'exposure_reference' missing or not a light level in [0, 1]"
+            )
         if stored.exposure in REFERENCE_EXPOSURES and ref <= 0:
             raise MapFileError(
                 f"{path}: exposure={stored.exposure!r} but no reference level stored"
@@ -956,6 +985,11 @@ class VisualCompass:
             or np.any(sizes < 1)
         ):
             raise MapFileError(f"{path}: entry 'learned_sizes' missing or not an (N, 2) int array")
+        if sizes.shape[0] > MAX_LEARNED_SIZES:
+            raise MapFileError(
+                f"{path}: entry 'learned_sizes' lists {sizes.shape[0]} frame sizes, more than "
+                f"{MAX_LEARNED_SIZES}"
+            )
         if stored.exposure == "map":
             _read_light(vc._light, arrays, path)
         vc._counts[:] = counts
@@ -1151,6 +1185,16 @@ def _read_light(light: LightMap, arrays: Mapping[str, np.ndarray], path: object)
         raise MapFileError(f"{path}: light_sum exceeds light_columns (levels above 1)")
     light.level_sum[:] = level_sum
     light.columns[:] = columns
+
+
+def _check_sizes(sizes: set[tuple[int, int]]) -> None:
+    """A ``ValueError`` if a map would remember more than :data:`MAX_LEARNED_SIZES`
+    frame sizes (the loader refuses such a file)."""
+    if len(sizes) > MAX_LEARNED_SIZES:
+        raise ValueError(
+            f"a map learns frames of at most {MAX_LEARNED_SIZES} different sizes; this one "
+            f"would have {len(sizes)}"
+        )
 
 
 def _same_colors(a: ColorClasses, b: ColorClasses) -> bool:

@@ -15,15 +15,21 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.angles import circular_mean, circular_std, steps_in_circle
+from vc_gym.angles import MIN_HEADING_STEP_DEG, circular_mean, circular_std, steps_in_circle
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
+from vc_gym.validation import MAX_ABS_DEG
 from vc_gym.validation import finite_float as _finite
 
-__all__ = ["HeadingGridFilter", "mixing_lambda", "RULES"]
+__all__ = ["HeadingGridFilter", "mixing_lambda", "RULES", "UNIFORM_SPREAD_DEG"]
 
 #: Sensor update rules of :class:`HeadingGridFilter`.
 RULES = ("mixing", "bayes")
+#: A blur (spread or motion noise) of this many degrees or more leaves a uniform
+#: belief: the wrapped Gaussian's first harmonic, ``exp(-2 π² σ² / 360²)``, is below
+#: 1e-300 from 2,130° on, so the blur is computed with at most this width and the
+#: result is the same uniform belief to the last bit.
+UNIFORM_SPREAD_DEG = 3600.0
 
 
 def mixing_lambda(half_life_s: float, dt_s: float) -> float:
@@ -37,6 +43,24 @@ def mixing_lambda(half_life_s: float, dt_s: float) -> float:
     if h <= 0 or dt <= 0:
         raise ValueError(f"half_life_s and dt_s must be > 0, got {half_life_s}, {dt_s}")
     return 1.0 - 2.0 ** (-dt / h)
+
+
+def _angle(name: str, value: object) -> float:
+    """A finite angle within ``±MAX_ABS_DEG`` (beyond it float64 holds no fraction of a
+    degree), else a ``ValueError`` naming ``name`` and the range."""
+    v = _finite(name, value)
+    if abs(v) > MAX_ABS_DEG:
+        raise ValueError(f"{name} must be within ±{MAX_ABS_DEG:g}°, got {value!r}")
+    return v
+
+
+def _spread(name: str, value: object) -> float:
+    """A standard deviation in ``[0, MAX_ABS_DEG]`` degrees, else a ``ValueError``
+    naming ``name`` and the range."""
+    v = _finite(name, value)
+    if not 0 <= v <= MAX_ABS_DEG:
+        raise ValueError(f"{name} must be in [0, {MAX_ABS_DEG:g}] degrees, got {value!r}")
+    return v
 
 
 class HeadingGridFilter:
@@ -76,9 +100,12 @@ class HeadingGridFilter:
         dt_s: float = 1.0 / 30.0,
     ):
         res = _finite("resolution_deg", resolution_deg)
-        n_bins = steps_in_circle(res) if 0 < res <= 90 else None
+        # the finest grid any sensor takes (36,000 bins): finer ones only cost memory
+        n_bins = steps_in_circle(res) if MIN_HEADING_STEP_DEG <= res <= 90 else None
         if n_bins is None:
-            raise ValueError(f"resolution_deg must be in (0, 90] and divide 360, got {res}")
+            raise ValueError(
+                f"resolution_deg must be in [{MIN_HEADING_STEP_DEG}, 90] and divide 360, got {res}"
+            )
         if rule not in RULES:
             raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
         mixing_lambda(half_life_s, dt_s)  # validates both
@@ -105,15 +132,27 @@ class HeadingGridFilter:
         return self._belief.copy()
 
     def reset(self, heading_deg: float | None = None, spread_deg: float | None = None) -> None:
-        """Uniform belief (no argument) or a wrapped Gaussian around ``heading_deg``."""
+        """Uniform belief (no argument) or a wrapped Gaussian around ``heading_deg``.
+
+        Parameters
+        ----------
+        heading_deg : float, optional
+            Centre of the belief, within ``±MAX_ABS_DEG`` (wrapped onto the grid).
+        spread_deg : float, optional
+            Standard deviation, in ``[0, MAX_ABS_DEG]`` (default: one grid bin); from
+            :data:`UNIFORM_SPREAD_DEG` on the belief is uniform.
+
+        Raises
+        ------
+        ValueError
+            On a heading or spread outside those ranges, or not finite.
+        """
         n = self._headings.size
         if heading_deg is None:
             self._belief = np.full(n, 1.0 / n)
             return
-        mu = _finite("heading_deg", heading_deg)
-        sd = _finite("spread_deg", self.resolution_deg if spread_deg is None else spread_deg)
-        if sd < 0:
-            raise ValueError(f"spread_deg must be >= 0, got {spread_deg}")
+        mu = _angle("heading_deg", heading_deg)
+        sd = _spread("spread_deg", self.resolution_deg if spread_deg is None else spread_deg)
         b = np.zeros(n)
         b[int(round(mu / self.resolution_deg)) % n] = 1.0
         self._belief = b
@@ -132,8 +171,10 @@ class HeadingGridFilter:
     def _blur(self, noise_deg: float) -> None:
         if noise_deg <= 0:
             return
-        # Fourier transform of a Gaussian: exp(-2 pi^2 sigma^2 f^2); wrapped on the circle
-        kernel = np.exp(-2.0 * (math.pi * noise_deg * self._freq) ** 2)
+        # Fourier transform of a Gaussian: exp(-2 pi^2 sigma^2 f^2); wrapped on the circle.
+        # Wider than UNIFORM_SPREAD_DEG it is 1 at f = 0 and 0 elsewhere: uniform
+        sigma = min(noise_deg, UNIFORM_SPREAD_DEG)
+        kernel = np.exp(-2.0 * (math.pi * sigma * self._freq) ** 2)
         b = np.fft.irfft(np.fft.rfft(self._belief) * kernel, n=self._belief.size)
         b = np.clip(b, 0.0, None)
         self._belief = b / b.sum()
@@ -144,14 +185,19 @@ class HeadingGridFilter:
         Parameters
         ----------
         dtheta_deg : float
-            Turn since the last step (degrees, CCW positive), e.g. from odometry.
+            Turn since the last step (degrees, CCW positive), e.g. from odometry,
+            within ``±MAX_ABS_DEG``.
         noise_deg : float
-            Standard deviation of the turn's error (>= 0).
+            Standard deviation of the turn's error, in ``[0, MAX_ABS_DEG]``; from
+            :data:`UNIFORM_SPREAD_DEG` on the belief becomes uniform.
+
+        Raises
+        ------
+        ValueError
+            On a turn or noise outside those ranges, or not finite.
         """
-        d = _finite("dtheta_deg", dtheta_deg)
-        s = _finite("noise_deg", noise_deg)
-        if s < 0:
-            raise ValueError(f"noise_deg must be >= 0, got {noise_deg}")
+        d = _angle("dtheta_deg", dtheta_deg)
+        s = _spread("noise_deg", noise_deg)
         shift = d / self.resolution_deg
         k = math.floor(shift)
         frac = shift - k

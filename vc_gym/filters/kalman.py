@@ -33,16 +33,30 @@ from typing import Any
 import numpy as np
 from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
-from vc_gym.angles import circular_mean, circular_std, wrap180, wrap360
+from vc_gym.angles import (
+    MIN_HEADING_STEP_DEG,
+    circular_mean,
+    circular_std,
+    steps_in_circle,
+    wrap180,
+    wrap360,
+)
 from vc_gym.filters.estimates import HeadingEstimate
 from vc_gym.filters.protocol import HeadingSensor, check_log_likelihood
 from vc_gym.validation import MAX_ABS_DEG, positive_float
 from vc_gym.validation import finite_float as _finite
 
-__all__ = ["MIN_SPREAD_DEG", "KalmanHeadingFilter"]
+__all__ = ["MAX_DT_S", "MAX_RATE_DEG_PER_S", "MIN_SPREAD_DEG", "KalmanHeadingFilter"]
 
 #: Smallest measurement spread :meth:`KalmanHeadingFilter.update` takes (degrees).
 MIN_SPREAD_DEG = 1e-6
+#: Largest turn-rate spread and random-walk noise (deg/s) the rate state takes: far
+#: beyond any robot's turn rate (a billion degrees a second), and their squares times
+#: :data:`MAX_DT_S` stay far from overflowing the covariance.
+MAX_RATE_DEG_PER_S = MAX_ABS_DEG
+#: Longest prediction step (seconds, a million: eleven days): ``rate · dt`` and the
+#: rate variance's growth ``noise² · dt`` stay finite.
+MAX_DT_S = 1e6
 
 #: Sigma-point parameters (Van der Merwe). A small α keeps the sigma points within
 #: ``0.17 σ`` of the mean, so they never wrap around the circle; β = 2 is optimal for
@@ -117,8 +131,9 @@ class KalmanHeadingFilter:
     Raises
     ------
     ValueError
-        On a non-finite heading, a spread outside ``(0, MAX_SPREAD_DEG]``, or a
-        non-positive / non-finite rate parameter.
+        On a non-finite heading, a spread outside ``(0, MAX_SPREAD_DEG]``, or a rate
+        spread outside ``(0, MAX_RATE_DEG_PER_S]`` or rate noise outside
+        ``[0, MAX_RATE_DEG_PER_S]``.
 
     Examples
     --------
@@ -146,10 +161,16 @@ class KalmanHeadingFilter:
     ) -> None:
         self._with_rate = bool(turn_rate_state)
         self._rate_spread = positive_float("rate_spread_deg_per_s", rate_spread_deg_per_s)
-        self._rate_noise = float(rate_noise_deg_per_s)
-        if not math.isfinite(self._rate_noise) or self._rate_noise < 0.0:
+        if self._rate_spread > MAX_RATE_DEG_PER_S:
             raise ValueError(
-                f"rate_noise_deg_per_s must be finite and >= 0, got {rate_noise_deg_per_s!r}"
+                f"rate_spread_deg_per_s must be in (0, {MAX_RATE_DEG_PER_S:g}], "
+                f"got {rate_spread_deg_per_s!r}"
+            )
+        self._rate_noise = _finite("rate_noise_deg_per_s", rate_noise_deg_per_s)
+        if not 0.0 <= self._rate_noise <= MAX_RATE_DEG_PER_S:
+            raise ValueError(
+                f"rate_noise_deg_per_s must be in [0, {MAX_RATE_DEG_PER_S:g}], "
+                f"got {rate_noise_deg_per_s!r}"
             )
         n = 2 if self._with_rate else 1
         self._points = MerweScaledSigmaPoints(n, alpha=_ALPHA, beta=_BETA, kappa=3.0 - n)
@@ -266,12 +287,14 @@ class KalmanHeadingFilter:
         noise_deg : float
             Standard deviation of the turn's error over this step, ``>= 0``.
         dt : float
-            Duration of the step in seconds, ``> 0`` (only the rate state uses it).
+            Duration of the step in seconds, in ``(0, MAX_DT_S]`` (only the rate state
+            uses it).
 
         Raises
         ------
         ValueError
-            On non-finite input, ``noise_deg < 0`` or ``dt <= 0``.
+            On non-finite input, ``noise_deg`` outside ``[0, MAX_ABS_DEG]``,
+            ``|dtheta_deg| > MAX_ABS_DEG`` or ``dt`` outside ``(0, MAX_DT_S]``.
         """
         d = _finite("dtheta_deg", dtheta_deg)
         q = _finite("noise_deg", noise_deg)
@@ -284,6 +307,8 @@ class KalmanHeadingFilter:
                 f"{dtheta_deg!r}, {noise_deg!r}"
             )
         step = positive_float("dt", dt)
+        if step > MAX_DT_S:
+            raise ValueError(f"dt must be in (0, {MAX_DT_S:g}] seconds, got {dt!r}")
         ukf = self._ukf
         if self._with_rate:
             ukf.Q = np.diag([q * q, self._rate_noise**2 * step])
@@ -362,7 +387,8 @@ class KalmanHeadingFilter:
         observation : Any
             What the sensor reads, passed through unchanged.
         grid_step_deg : float
-            Grid resolution, must divide 360 (e.g. 0.5, 1, 2, 4.5).
+            Grid resolution in ``[MIN_HEADING_STEP_DEG, 90]``, must divide 360 (e.g.
+            0.5, 1, 2, 4.5).
 
         Returns
         -------
@@ -385,9 +411,13 @@ class KalmanHeadingFilter:
                 f"sensor must have a heading_log_likelihood method, got {type(sensor).__name__}"
             )
         step = positive_float("grid_step_deg", grid_step_deg)
-        n = round(360.0 / step)
-        if n < 1 or not math.isclose(n * step, 360.0, rel_tol=0.0, abs_tol=1e-9):
-            raise ValueError(f"grid_step_deg must divide 360, got {grid_step_deg!r}")
+        # the finest grid any sensor takes: finer ones only cost memory and time
+        n = steps_in_circle(step) if MIN_HEADING_STEP_DEG <= step <= 90.0 else None
+        if n is None:
+            raise ValueError(
+                f"grid_step_deg must be in [{MIN_HEADING_STEP_DEG}, 90] and divide 360, "
+                f"got {grid_step_deg!r}"
+            )
         headings = np.arange(n, dtype=np.float64) * step
         who = type(sensor).__name__
         ll = check_log_likelihood(sensor.heading_log_likelihood(observation, headings), n, who)

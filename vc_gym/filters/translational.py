@@ -16,15 +16,27 @@ import numpy as np
 from vc_gym.filters.grid import mixing_lambda
 from vc_gym.validation import MAX_ABS_METRES
 
-__all__ = ["TranslationalFilter", "weighted_spot_position"]
+__all__ = ["MAX_GOODNESS", "TranslationalFilter", "weighted_spot_position"]
+
+#: Largest goodness value ``L_i`` (a likelihood ratio, about 1 at home) eq. 30 takes:
+#: a million is far beyond any spot's fit, and sums of values near float64's limit
+#: overflow to inf.
+MAX_GOODNESS = 1e6
 
 
-def _vector(name: str, value: object, n: int) -> np.ndarray:
-    a = np.asarray(value, dtype=np.float64)
+def _vector(
+    name: str, value: object, n: int, limit: float = MAX_ABS_METRES, unit: str = " m"
+) -> np.ndarray:
+    """``value`` as ``n`` finite float64 numbers within ``±limit`` (``unit`` in the
+    message), else a ``ValueError`` naming ``name``."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {n} real numbers, got {value!r}") from None
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must be {n} finite numbers, got {value!r}")
-    if np.any(np.abs(a) > MAX_ABS_METRES):  # sums of such values overflow to inf
-        raise ValueError(f"{name} must be within ±{MAX_ABS_METRES:g} m, got {value!r}")
+    if np.any(np.abs(a) > limit):  # sums of such values overflow to inf
+        raise ValueError(f"{name} must be within ±{limit:g}{unit}, got {value!r}")
     return a
 
 
@@ -36,18 +48,21 @@ def weighted_spot_position(spots: np.ndarray, goodness: np.ndarray) -> np.ndarra
     spots : numpy.ndarray
         ``(q, 2)`` training spot positions ``T_i``.
     goodness : numpy.ndarray
-        ``(q,)`` non-negative goodness values ``L_i`` (normalised at home).
+        ``(q,)`` goodness values ``L_i`` (normalised at home) in
+        ``[0, MAX_GOODNESS]``.
 
     Raises
     ------
     ValueError
-        On negative, non-finite or all-zero goodness, or mismatched shapes.
+        On negative, too large, non-finite or all-zero goodness, or mismatched shapes.
     """
     spots = np.asarray(spots, dtype=np.float64)
     q = spots.shape[0]
-    g = _vector("goodness", goodness, q)
+    g = _vector("goodness", goodness, q, MAX_GOODNESS, unit="")
     if np.any(g < 0) or g.sum() <= 0:
-        raise ValueError(f"goodness must be non-negative and not all zero, got {goodness!r}")
+        raise ValueError(
+            f"goodness must be in [0, {MAX_GOODNESS:g}] and not all zero, got {goodness!r}"
+        )
     return (g / g.sum()) @ spots
 
 
@@ -77,6 +92,8 @@ class TranslationalFilter:
         s = np.asarray(spots, dtype=np.float64)
         if s.ndim != 2 or s.shape[1] != 2 or s.shape[0] < 1 or not np.all(np.isfinite(s)):
             raise ValueError(f"spots must be a finite (q, 2) array, got shape {s.shape}")
+        if np.any(np.abs(s) > MAX_ABS_METRES):
+            raise ValueError(f"spots must lie within ±{MAX_ABS_METRES:g} m, got {spots!r}")
         mixing_lambda(half_life_s, dt_s)  # validates
         self.spots = s.copy()
         self.spots.setflags(write=False)

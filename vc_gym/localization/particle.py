@@ -6,6 +6,7 @@ import numpy as np
 
 from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas
 from vc_gym.filters import ParticleFilter
+from vc_gym.filters.particle import check_particle_count
 from vc_gym.localization.protocol import (
     TrackerState,
     atlas_tracker_state,
@@ -18,7 +19,7 @@ from vc_gym.localization.sensors import (
     tempered_distribution,
 )
 from vc_gym.localization.shortlist import SpotShortlist
-from vc_gym.validation import nonnegative_float, positive_float
+from vc_gym.validation import MAX_ABS_DEG, MAX_ABS_METRES, nonnegative_float, positive_float
 
 __all__ = ["ParticleTracker"]
 
@@ -40,6 +41,14 @@ class _RobustFrameSensor:
         if not np.isfinite(top):
             return ll
         return np.log(self.outlier + (1.0 - self.outlier) * np.exp(ll - top))
+
+
+def _at_most(name: str, metres: float) -> float:
+    """``metres`` if it is at most :data:`~vc_gym.validation.MAX_ABS_METRES` (beyond
+    it positions overflow), else a ``ValueError`` naming ``name``."""
+    if metres > MAX_ABS_METRES:
+        raise ValueError(f"{name} must be at most {MAX_ABS_METRES:g} m, got {metres!r}")
+    return metres
 
 
 class ParticleTracker:
@@ -65,12 +74,14 @@ class ParticleTracker:
     Parameters
     ----------
     n_particles : int
-        Number of particles.
+        Number of particles, in ``[1, MAX_PARTICLES]`` (1,000,000; see
+        :data:`vc_gym.filters.particle.MAX_PARTICLES`).
     bounds : tuple of float, optional
         ``(xmin, xmax, ymin, ymax)`` where particles are drawn at the start and
         injected. Default: the spots' bounding box grown by ``margin_m``.
     margin_m : float
-        Growth of the default bounds around the spots.
+        Growth of the default bounds around the spots (at most a million metres, as
+        every length below).
     position_noise_m : float
         σ of the atlas position reading. Eq. 30 is biased towards the spots' centroid
         away from them; a wide σ with a generous motion noise lets the particles forget
@@ -109,12 +120,12 @@ class ParticleTracker:
         shortlist: int | None = None,
         rescore_every: int = 4,
     ):
-        if isinstance(n_particles, bool) or not isinstance(n_particles, int) or n_particles < 1:
-            raise ValueError(f"n_particles must be an int >= 1, got {n_particles!r}")
-        self.n_particles = n_particles
+        self.n_particles = check_particle_count(n_particles)
         self.bounds = None if bounds is None else ParticleFilter._check_bounds(bounds)
-        self.margin_m = nonnegative_float("margin_m", margin_m)
-        self.position_noise_m = positive_float("position_noise_m", position_noise_m)
+        self.margin_m = _at_most("margin_m", nonnegative_float("margin_m", margin_m))
+        self.position_noise_m = _at_most(
+            "position_noise_m", positive_float("position_noise_m", position_noise_m)
+        )
         self.heading_temperature = positive_float("heading_temperature", heading_temperature)
         self.outlier = nonnegative_float("outlier", outlier)
         if self.outlier >= 1:
@@ -125,6 +136,11 @@ class ParticleTracker:
         noise = tuple(nonnegative_float("motion_noise", v) for v in motion_noise)
         if len(noise) != 3:
             raise ValueError(f"motion_noise must be 3 numbers, got {motion_noise!r}")
+        if max(noise[:2]) > MAX_ABS_METRES or noise[2] > MAX_ABS_DEG:
+            raise ValueError(
+                f"motion_noise must be within {MAX_ABS_METRES:g} m, {MAX_ABS_METRES:g} m and "
+                f"{MAX_ABS_DEG:g}°, got {motion_noise!r}"
+            )
         self.motion_noise = noise
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
             raise ValueError(f"seed must be an int, got {seed!r}")
