@@ -28,6 +28,7 @@ decision that stands for many task steps still counts as one.
 
 from __future__ import annotations
 
+import shutil
 import tempfile
 import time
 from dataclasses import replace
@@ -37,6 +38,7 @@ from typing import Any
 import numpy as np
 
 import vc_gym  # noqa: F401  (registers the envs)
+from vc_gym.experiments.runner import check_workers
 from vc_gym.experiments.training import (
     COLLECTORS,
     TrainConfig,
@@ -44,9 +46,14 @@ from vc_gym.experiments.training import (
     train,
     training_env,
 )
-from vc_gym.validation import int_at_least
+from vc_gym.validation import check_seed, int_in_range
 
-__all__ = ["bench_train"]
+__all__ = ["MAX_ENV_STEPS", "MAX_TIMESTEPS", "bench_train"]
+
+#: Most decisions per training run of the benchmark (the default is 2,048).
+MAX_TIMESTEPS = 1_000_000
+#: Most decisions per single-env round.
+MAX_ENV_STEPS = 100_000
 
 
 def _env_rate(config: TrainConfig, run_dir: Path, steps: int, seed: int) -> tuple[float, float]:
@@ -85,12 +92,13 @@ def bench_train(
     ----------
     timesteps : int
         Decisions to train for with each collector (PPO, the default hyperparameters
-        otherwise).
+        otherwise; 1 to :data:`MAX_TIMESTEPS`).
     n_envs : int
-        Worker processes of the training runs.
+        Worker processes of the training runs (1 to
+        :func:`~vc_gym.experiments.runner.max_workers`).
     env_steps : int
         Decisions of each single-env round (one before the first training and one after
-        each; every round takes the same actions).
+        each; every round takes the same actions; 1 to :data:`MAX_ENV_STEPS`).
     learn_time_s : float
         Learning time per direction of the (untimed) learning phase.
     seed : int
@@ -112,7 +120,10 @@ def bench_train(
         collectors ``async_over_lockstep``, the ratio of their decision rates; and the
         settings.
     """
-    int_at_least("env_steps", env_steps, 1)
+    int_in_range("timesteps", timesteps, 1, MAX_TIMESTEPS)
+    check_workers(n_envs, "n_envs")
+    int_in_range("env_steps", env_steps, 1, MAX_ENV_STEPS)
+    check_seed("seed", seed)
     collectors = tuple(collectors)
     if not collectors or any(c not in COLLECTORS for c in collectors):
         raise ValueError(f"collectors must be a non-empty subset of {COLLECTORS}, got {collectors}")
@@ -131,7 +142,13 @@ def bench_train(
         learn_places(config, tmp)
         rounds.append(_env_rate(config, Path(tmp), env_steps, seed))
         for name in collectors:
-            runs[name] = train(replace(config, collector=name), tmp, progress=progress)
+            # each collector's run in a folder of its own (a run refuses another's
+            # folder), with the place learned above copied in
+            run_dir = Path(tmp) / name
+            run_dir.mkdir()
+            for atlas in config.atlas_files(tmp):
+                shutil.copy2(atlas, run_dir / atlas.name)
+            runs[name] = train(replace(config, collector=name), run_dir, progress=progress)
             rounds.append(_env_rate(config, Path(tmp), env_steps, seed))
     per_collector = {}
     for k, (name, run) in enumerate(runs.items()):

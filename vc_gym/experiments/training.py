@@ -5,15 +5,26 @@ through the compass and a tracker, :mod:`vc_gym.envs.homing`) in parallel worker
 processes (``SubprocVecEnv``) and writes ``model.zip``, ``config.json``,
 ``train_log.json`` and ``learning_curve.png``;
 :class:`~vc_gym.agents.learned.LearnedHomingAgent` loads them.
+
+A run owns its folder: a new run refuses a folder that holds one
+(:func:`check_new_run_dir`), and only ``resume`` continues one. Checkpoints and every
+other file but SB3's monitor logs are written atomically, and a resume skips a
+checkpoint that does not load, so an interrupted run can be resumed from its last whole
+checkpoint. Settings files choose no code: a tracker or scene read from a file must be a
+registered plug-in (:func:`read_train_config`).
 """
 
 from __future__ import annotations
 
 import json
+import numbers
 import os
+import reprlib
+import sys
 import time
 import warnings
-from dataclasses import asdict, dataclass, fields, replace
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +33,7 @@ import numpy as np
 
 from vc_gym.agents.feature_expert import HomingFeatureExpert
 from vc_gym.agents.learned import ALGORITHMS, algorithm_class
-from vc_gym.agents.safe_load import load_sb3_model
+from vc_gym.agents.safe_load import MAX_LAYER_WIDTH, MAX_LAYERS, load_sb3_model
 from vc_gym.config_files import read_settings
 from vc_gym.envs.homing import home_offset
 from vc_gym.envs.place_pool import PlacePool
@@ -32,10 +43,22 @@ from vc_gym.experiments.home_offset import MIN_STOPS, centre_home_offset, measur
 from vc_gym.experiments.imitation import clone_behaviour, collect_demonstrations
 from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.localization import make_tracker
+from vc_gym.localization.registry import TRACKERS
 from vc_gym.persistence import write_atomic
-from vc_gym.validation import flag, int_at_least, nonnegative_float, positive_float
+from vc_gym.plugins import check_file_spec, check_plain_data
+from vc_gym.validation import finite_real, flag, int_at_least, nonnegative_float, positive_float
 
-__all__ = ["TrainConfig", "check_names", "read_train_config", "train"]
+__all__ = [
+    "TrainConfig",
+    "check_names",
+    "check_new_run_dir",
+    "checkpoints",
+    "continue_run",
+    "latest_checkpoint",
+    "read_train_config",
+    "run_files",
+    "train",
+]
 
 CONFIG_SCHEMA = 2
 #: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
@@ -54,6 +77,58 @@ HOME_OFFSET_SEED = 2_000_000
 COLLECTORS = ("lockstep", "async")
 #: At most this many places per training run (each is a PyBullet world in every worker).
 MAX_PLACES = 16
+#: Accepted values of ``TrainConfig.vec_env``.
+VEC_ENVS = ("subproc", "dummy")
+#: At most this many parallel environments (``TrainConfig.n_envs``): one worker process
+#: each.
+MAX_N_ENVS = 256
+#: Checkpoints of a run are ``checkpoints/<prefix>_<decisions>_steps.zip``.
+CHECKPOINT_PREFIX = "model"
+#: What a training run writes into its folder (besides the atlases, which a new run may
+#: find there and reuse, :func:`learn_places`), and the marker of a sweep's folder: a
+#: folder holding any of them holds a run, and a new run refuses it
+#: (:func:`check_new_run_dir`).
+RUN_FILES = (
+    "config.json",
+    "model.zip",
+    "train_log.json",
+    "checkpoints",
+    "best",
+    "eval",
+    "monitor",
+    "warm_start.json",
+    "home_offset.json",
+    "learning_curve.png",
+    "jobs",
+)
+#: Largest ``train_log.json`` read back when a run resumes (bytes; an episode takes
+#: about 150).
+MAX_TRAIN_LOG_BYTES = 100_000_000
+#: Integer fields of :class:`TrainConfig` and the smallest value each accepts.
+_INT_FIELDS = {
+    "timesteps": 1,
+    "n_envs": 1,
+    "n_steps": 1,
+    "batch_size": 1,
+    "eval_episodes": 1,
+    "eval_freq": 0,
+    "eval_seed": 0,
+    "save_freq": 0,
+    "seed": 0,
+    "demo_episodes": 0,
+    "home_offset_episodes": 0,
+    "home_offset_places": 0,
+}
+#: Float fields of :class:`TrainConfig` that must be finite and > 0.
+_POSITIVE_FIELDS = (
+    "learn_time_s",
+    "stop_time_s",
+    "success_radius_m",
+    "max_homing_s",
+    "learning_rate",
+    "max_forward",
+    "max_turn_deg_s",
+)
 
 
 @dataclass(frozen=True)
@@ -146,7 +221,8 @@ class TrainConfig:
         (``None``): ``"async"`` with PPO in worker processes, else ``"lockstep"``. A
         ``config.json`` saved before the field existed was trained in lockstep.
     net_arch : tuple of int
-        Hidden layers of the policy and value MLPs.
+        Hidden layers of the policy and value MLPs: 1 to :data:`MAX_LAYERS` widths, each
+        an integer from 1 to :data:`MAX_LAYER_WIDTH`.
     learning_rate, gamma : float
         Optimiser step and discount.
     n_steps : int
@@ -159,8 +235,13 @@ class TrainConfig:
         Walking speed (m/s) of a full forward action.
     max_turn_deg_s : float
         Turn rate (deg/s) of a full turn action.
-    tracker : str
-        Tracker of the agent's env (``"grid"``, ``"particle"``, ``"kalman"``).
+    tracker : str or dict
+        Tracker of the agent's env: a registered name (``"grid"``, ``"particle"``,
+        ``"kalman"``, any ``register_tracker`` name) or ``{"type": name, **kwargs}`` with
+        plain-data arguments (kept as a plain dict, so ``config.json`` stays JSON). From
+        Python code or the command line the name may also be an import path
+        ``"package.module:factory"``; from a file only with ``allow_imports``
+        (:func:`read_train_config`).
     eval_freq : int
         Decisions between evaluations on held-out kidnappings (0: none). The model with
         the best mean return is kept as ``best/best_model.zip``.
@@ -170,7 +251,7 @@ class TrainConfig:
         Seed of the held-out kidnappings (training envs use ``seed + i``).
     save_freq : int
         Decisions between checkpoints in ``checkpoints/`` (0: none); ``--resume DIR``
-        continues from the latest.
+        continues from the latest that loads.
     demo_episodes : int
         Warm start (PPO only): episodes of the scripted expert
         (:class:`~vc_gym.agents.HomingFeatureExpert`) whose decisions the policy is
@@ -210,7 +291,7 @@ class TrainConfig:
     log_std_init: float = -0.5
     max_forward: float = 0.4
     max_turn_deg_s: float = 60.0
-    tracker: str = "grid"
+    tracker: str | dict[str, Any] = "grid"
     eval_freq: int = 20_000
     eval_episodes: int = 10
     eval_seed: int = 1_000_000
@@ -218,51 +299,49 @@ class TrainConfig:
     demo_episodes: int | None = None
 
     def __post_init__(self) -> None:
-        if self.algo not in ALGORITHMS:
+        # every field's type is checked here, whoever built the config (Python code, a
+        # settings file, a run's config.json): a ValueError names the field and what it
+        # accepts; the values are stored as plain Python ints, floats, bools and strings
+        # (numpy numbers too become plain ones), so config.json stays JSON
+        if not isinstance(self.algo, str) or self.algo not in ALGORITHMS:
             raise ValueError(f"algo must be one of {ALGORITHMS}, got {self.algo!r}")
         if self.demo_episodes is None:
             object.__setattr__(self, "demo_episodes", DEFAULT_DEMO_EPISODES[self.algo])
-        if not isinstance(self.tracker, str):
-            raise ValueError(f"tracker must be a tracker name, got {self.tracker!r}")
-        if self.vec_env not in ("subproc", "dummy"):
-            raise ValueError(f"vec_env must be 'subproc' or 'dummy', got {self.vec_env!r}")
+        for name, minimum in _INT_FIELDS.items():
+            object.__setattr__(self, name, int_at_least(name, getattr(self, name), minimum))
+        for name, maximum in (("n_envs", MAX_N_ENVS), ("home_offset_places", MAX_PLACES)):
+            if getattr(self, name) > maximum:
+                raise ValueError(f"{name} must be at most {maximum}, got {getattr(self, name)}")
+        for name in _POSITIVE_FIELDS:
+            object.__setattr__(self, name, positive_float(name, getattr(self, name)))
+        for name in ("closeness_bonus", "min_walk_m"):
+            object.__setattr__(self, name, nonnegative_float(name, getattr(self, name)))
+        object.__setattr__(self, "log_std_init", finite_real("log_std_init", self.log_std_init))
+        if self.confirm_stop_m is not None:
+            object.__setattr__(
+                self, "confirm_stop_m", positive_float("confirm_stop_m", self.confirm_stop_m)
+            )
+        gamma = finite_real("gamma", self.gamma)
+        if not (0 < gamma <= 1):
+            raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
+        object.__setattr__(self, "gamma", gamma)
+        for name in ("previous_action", "home_offset_centre"):
+            object.__setattr__(self, name, flag(name, getattr(self, name)))
+        if not isinstance(self.scene, str) or not self.scene:
+            raise ValueError(f"scene must be a scene name (a string), got {self.scene!r}")
+        object.__setattr__(self, "tracker", _tracker_field(self.tracker))
+        if not isinstance(self.vec_env, str) or self.vec_env not in VEC_ENVS:
+            raise ValueError(f"vec_env must be one of {VEC_ENVS}, got {self.vec_env!r}")
         if self.collector is None:
             parallel = self.algo == "ppo" and self.vec_env == "subproc"
             object.__setattr__(self, "collector", "async" if parallel else "lockstep")
-        if self.collector not in COLLECTORS:
+        if not isinstance(self.collector, str) or self.collector not in COLLECTORS:
             raise ValueError(f"collector must be one of {COLLECTORS}, got {self.collector!r}")
         if self.collector == "async" and (self.algo != "ppo" or self.vec_env != "subproc"):
             raise ValueError(
                 "collector 'async' needs algo 'ppo' and vec_env 'subproc' (worker processes; "
                 "vc-gym train --n-envs 1 runs its env in-process)"
             )
-        for name in ("timesteps", "n_envs", "n_steps", "batch_size", "eval_episodes"):
-            int_at_least(name, getattr(self, name), 1)
-        for name in ("eval_freq", "eval_seed", "save_freq", "seed", "demo_episodes"):
-            int_at_least(name, getattr(self, name), 0)
-        for name in (
-            "learn_time_s",
-            "stop_time_s",
-            "success_radius_m",
-            "max_homing_s",
-            "learning_rate",
-            "max_forward",
-            "max_turn_deg_s",
-        ):
-            v = getattr(self, name)
-            positive_float(name, v)
-        if self.confirm_stop_m is not None:
-            positive_float("confirm_stop_m", self.confirm_stop_m)
-        nonnegative_float("closeness_bonus", self.closeness_bonus)
-        nonnegative_float("min_walk_m", self.min_walk_m)
-        int_at_least("home_offset_episodes", self.home_offset_episodes, 0)
-        int_at_least("home_offset_places", self.home_offset_places, 0)
-        if self.home_offset_places > MAX_PLACES:
-            raise ValueError(
-                f"home_offset_places must be at most {MAX_PLACES}, got {self.home_offset_places}"
-            )
-        flag("previous_action", self.previous_action)
-        flag("home_offset_centre", self.home_offset_centre)
         if self.home_offset_m is not None:
             object.__setattr__(self, "home_offset_m", home_offset(self.home_offset_m))
         elif self.home_offset_centre and not self.home_offset_episodes:
@@ -273,22 +352,21 @@ class TrainConfig:
             )
         if self.demo_episodes and self.algo != "ppo":
             raise ValueError("demo_episodes (the warm start) needs algo 'ppo'; use 0 with sac")
-        if not (0 < self.gamma <= 1):
-            raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
-        if not self.net_arch or any(int(n) < 1 for n in self.net_arch):
-            raise ValueError(f"net_arch must be positive layer sizes, got {self.net_arch!r}")
-        object.__setattr__(self, "net_arch", tuple(int(n) for n in self.net_arch))
+        object.__setattr__(self, "net_arch", _net_arch(self.net_arch))
         places = self.places
-        if isinstance(places, (str, bytes)) or not hasattr(places, "__iter__"):
+        if isinstance(places, (str, bytes)) or not isinstance(places, (Sequence, np.ndarray)):
             raise ValueError(f"places must be a sequence of learning seeds, got {places!r}")
-        places = tuple(places)
-        for s in places:
-            int_at_least("places entry", s, 0)
-        if len(set(places)) != len(places) or len(places) > MAX_PLACES:
+        if len(places) > MAX_PLACES:
+            raise ValueError(
+                f"places must be at most {MAX_PLACES} distinct learning seeds, "
+                f"got {reprlib.repr(places)}"
+            )
+        places = tuple(int_at_least("places entry", s, 0) for s in places)
+        if len(set(places)) != len(places):
             raise ValueError(
                 f"places must be at most {MAX_PLACES} distinct learning seeds, got {places!r}"
             )
-        object.__setattr__(self, "places", tuple(int(s) for s in places))
+        object.__setattr__(self, "places", places)
         n_measured = self.home_offset_episodes * len(self.home_offset_seeds)
         if 0 < n_measured < MIN_STOPS:
             raise ValueError(
@@ -296,6 +374,10 @@ class TrainConfig:
                 f"home_offset_episodes={self.home_offset_episodes} in "
                 f"{len(self.home_offset_seeds)} place(s)"
             )
+
+    def __hash__(self) -> int:
+        # the tracker may be a dict: hash the config's JSON form
+        return hash(json.dumps(self.to_dict(), sort_keys=True))
 
     @property
     def place_seeds(self) -> tuple[int, ...]:
@@ -350,7 +432,7 @@ class TrainConfig:
             "max_homing_s": self.max_homing_s,
             "max_forward": self.max_forward,
             "max_turn_deg_s": self.max_turn_deg_s,
-            "tracker": self.tracker,
+            "tracker": _plain_copy(self.tracker),
             **checked,
         }
 
@@ -393,6 +475,54 @@ class TrainConfig:
         return cls(**data)
 
 
+def _plain_copy(value: Any) -> Any:
+    """A deep copy of JSON-like plain data (tuples become lists)."""
+    return json.loads(json.dumps(value))
+
+
+def _tracker_field(spec: Any) -> str | dict[str, Any]:
+    """``TrainConfig.tracker`` checked: a name, or a ``{"type": name, ...}`` dict of plain
+    data (returned as a plain dict of its own)."""
+    if isinstance(spec, str):
+        if not spec:
+            raise ValueError("tracker must be a tracker name, got ''")
+        return spec
+    if isinstance(spec, Mapping):
+        name = spec.get("type")
+        if not isinstance(name, str) or not name:
+            raise ValueError(
+                f"tracker: a {{'type': name, **kwargs}} dict needs a 'type' name, "
+                f"got {reprlib.repr(spec)}"
+            )
+        check_plain_data(dict(spec), "tracker")
+        return _plain_copy(dict(spec))
+    raise ValueError(
+        "tracker must be a tracker name or a {'type': name, **kwargs} dict of plain data, "
+        f"got {type(spec).__name__}"
+    )
+
+
+def _net_arch(value: Any) -> tuple[int, ...]:
+    """``TrainConfig.net_arch`` checked: 1 to :data:`MAX_LAYERS` integer widths from 1 to
+    :data:`MAX_LAYER_WIDTH` (a string, a float or a bool is no width)."""
+    expected = (
+        f"net_arch must be a list of 1 to {MAX_LAYERS} layer widths, each an integer "
+        f"from 1 to {MAX_LAYER_WIDTH}, got {reprlib.repr(value)}"
+    )
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+        raise ValueError(expected)
+    if not 1 <= len(value) <= MAX_LAYERS:
+        raise ValueError(expected)
+    widths = []
+    for n in value:
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral):
+            raise ValueError(expected)
+        if not 1 <= int(n) <= MAX_LAYER_WIDTH:
+            raise ValueError(expected)
+        widths.append(int(n))
+    return tuple(widths)
+
+
 def _place_env(config: TrainConfig, seed: int, atlas_file: Path) -> gym.Env:
     """``vc_gym/Homing-v0`` of one place: learning seed ``seed``, its atlas learned once
     into ``atlas_file`` by the first env that needs it and loaded by every other."""
@@ -416,7 +546,13 @@ def training_env(config: TrainConfig, out_dir: str | os.PathLike) -> gym.Env:
 
 
 def check_names(config: TrainConfig) -> None:
-    """Refuse an unregistered scene or tracker of ``config`` with a clear ``ValueError``."""
+    """Refuse an unregistered scene or tracker of ``config`` with a clear ``ValueError``.
+
+    Builds the tracker once (a ``{"type": ...}`` dict's arguments are checked by its
+    constructor); an import path is imported. A config read from a file passed
+    :func:`read_train_config`'s checks first, which admit import paths only with
+    ``allow_imports``.
+    """
     check_scene_name(config.scene)
     make_tracker(config.tracker)
 
@@ -436,18 +572,50 @@ def learn_places(config: TrainConfig, out_dir: str | os.PathLike) -> int:
     return learned
 
 
-def read_train_config(path: str | os.PathLike, **overrides: Any) -> TrainConfig:
+def read_train_config(
+    path: str | os.PathLike, allow_imports: bool = False, **overrides: Any
+) -> TrainConfig:
     """A :class:`TrainConfig` from a YAML or JSON file of its fields, with ``overrides``
     on top. Any subset of the fields: the others take their defaults. A ``config.json``
     written by :func:`train` works too (it has a ``schema``; a field it lacks takes the
     value it had when the file was written, :meth:`TrainConfig.from_dict`).
 
+    A file chooses no code: its ``tracker`` must be a registered tracker name or
+    ``{"type": registered name, **plain-data kwargs}`` and its ``scene`` a registered
+    scene name, checked before anything is imported or built
+    (:func:`vc_gym.plugins.check_file_spec`). ``overrides`` are the caller's (Python
+    code, the command line) and are not checked this way: they may name import paths.
+
+    Parameters
+    ----------
+    path : path-like
+        The settings file (``.json``, ``.yml``, ``.yaml``; read with
+        :func:`vc_gym.config_files.read_settings`: bounded size and depth, no YAML
+        aliases, no repeated keys).
+    allow_imports : bool
+        Let the file's tracker be an import path ``"package.module:factory"`` (or a dict
+        whose ``type`` is one): the person at the keyboard vouches for the file. Default
+        False.
+    **overrides
+        Fields that replace the file's.
+
     Raises
     ------
     ValueError
-        Naming the file, for a file that cannot be read or an unknown or bad field.
+        Naming the file (and the field), for a file that cannot be read, an unknown or
+        bad field, or a tracker or scene that is not a registered plug-in.
     """
-    data = {**read_settings(path), **overrides}
+    data = read_settings(path)
+    if "tracker" in data and "tracker" not in overrides:
+        check_file_spec(
+            data["tracker"], TRACKERS, "tracker", f"{path}: field 'tracker'", allow_imports
+        )
+    if "scene" in data and "scene" not in overrides:
+        try:
+            check_scene_name(data["scene"])
+        except ValueError as exc:
+            raise ValueError(f"{path}: field 'scene': {exc}") from None
+    data = {**data, **overrides}
     try:
         if "schema" in data:  # a run's config.json: its missing fields are its era's
             data.pop("env", None)  # derived from the fields (a --config file overrides them)
@@ -486,18 +654,84 @@ class _EnvFactory:
 
 def _checkpoint_steps(path: Path) -> int | None:
     """Decisions of a ``model_<N>_steps.zip`` checkpoint (None for another name)."""
-    steps = path.stem[len("model_") : -len("_steps")]
+    prefix, suffix = f"{CHECKPOINT_PREFIX}_", "_steps"
+    if not (path.stem.startswith(prefix) and path.stem.endswith(suffix)):
+        return None
+    steps = path.stem[len(prefix) : -len(suffix)]
     return int(steps) if steps.isdigit() else None
+
+
+def checkpoints(run_dir: str | os.PathLike) -> list[Path]:
+    """The checkpoints in ``run_dir/checkpoints``, the one with the most decisions first."""
+    found = [
+        (steps, p)
+        for p in (Path(run_dir) / "checkpoints").glob(f"{CHECKPOINT_PREFIX}_*_steps.zip")
+        if (steps := _checkpoint_steps(p)) is not None
+    ]
+    return [p for _, p in sorted(found, reverse=True)]
 
 
 def latest_checkpoint(run_dir: str | os.PathLike) -> Path | None:
     """The checkpoint with the most decisions in ``run_dir/checkpoints`` (None if none)."""
-    found = [
-        (steps, p)
-        for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
-        if (steps := _checkpoint_steps(p)) is not None
-    ]
-    return max(found)[1] if found else None
+    found = checkpoints(run_dir)
+    return found[0] if found else None
+
+
+def run_files(run_dir: str | os.PathLike) -> list[str]:
+    """Which of :data:`RUN_FILES` ``run_dir`` holds (none for a missing folder)."""
+    out = Path(run_dir)
+    if not out.is_dir():
+        return []
+    return [name for name in RUN_FILES if os.path.lexists(out / name)]
+
+
+def check_new_run_dir(run_dir: str | os.PathLike) -> None:
+    """Refuse ``run_dir`` for a new run if it holds a run already.
+
+    A folder holding any of :data:`RUN_FILES` (``config.json``, ``model.zip``,
+    ``checkpoints/``, ``train_log.json``, ...) is another run's, or this one's from
+    before: training into it would mix two runs (a new ``config.json`` beside an old
+    ``model.zip``, old checkpoints that ``--resume`` would continue from). A missing or
+    empty folder, or one with only atlases (``atlas*.npz``, reused when learned the same
+    way, :func:`learn_places`) or unrelated files, is accepted.
+
+    Raises
+    ------
+    ValueError
+        ``--out DIR: ...`` naming what it holds and how to go on (``--resume`` or
+        another folder).
+    """
+    found = run_files(run_dir)
+    if found:
+        out = Path(run_dir)
+        raise ValueError(
+            f"--out {out}: holds a training run already ({', '.join(found)}); a new run "
+            f"starts in a folder without one. Continue that run with vc-gym train --resume "
+            f"{out} (train(..., resume=True)), or choose another --out"
+        )
+
+
+@dataclass
+class _RunStart:
+    """Where a run starts: its config, and with a checkpoint what it continues from."""
+
+    config: TrainConfig
+    checkpoint: Path | None = None
+    episodes: list[dict[str, Any]] = field(default_factory=list)
+    skipped: list[tuple[Path, str]] = field(default_factory=list)
+
+
+def _check_start(config: TrainConfig, tensorboard_log: str | os.PathLike | None) -> None:
+    """What :func:`train` checks before it touches the run folder."""
+    algorithm_class(config.algo)  # stable-baselines3 is installed
+    check_names(config)  # before the run folder is made, not in the workers
+    if tensorboard_log is not None:
+        try:
+            import tensorboard  # noqa: F401
+        except ImportError:
+            raise ValueError(
+                "--tensorboard-log needs the tensorboard package: pip install tensorboard"
+            ) from None
 
 
 def train(
@@ -514,14 +748,17 @@ def train(
     (the place, learned once; ``atlas-place<s>.npz`` per place with ``places``),
     ``monitor/<i>.monitor.csv`` (SB3's per-worker episode logs), with ``eval_freq``
     ``eval/evaluations.npz`` and ``best/best_model.zip`` (held-out kidnappings), with
-    ``save_freq`` ``checkpoints/model_<N>_steps.zip``.
+    ``save_freq`` ``checkpoints/model_<N>_steps.zip``. Every file but the monitor logs
+    (appended line by line) is written atomically, so an interrupted run (Ctrl-C) keeps
+    whole checkpoints to resume from.
 
     Parameters
     ----------
     config : TrainConfig
         The run's settings (saved as ``config.json`` before training starts).
     out_dir : path-like
-        The run folder.
+        The run folder. A new run refuses a folder that holds a run already
+        (:func:`check_new_run_dir`), before anything is written.
     progress : bool
         Show progress.
     tensorboard_log : path-like, optional
@@ -529,39 +766,93 @@ def train(
     resume : bool
         Continue the run in ``out_dir`` from its latest checkpoint up to
         ``config.timesteps`` decisions (its ``config.json`` must match ``config`` except
-        for ``timesteps``).
+        for ``timesteps``). A checkpoint that does not load (a torn or foreign file) is
+        skipped for the next older one; each skipped one is printed to stderr with the
+        reason and listed in the result's ``skipped_checkpoints``.
 
     Returns
     -------
     dict
         Paths, duration, decisions per second while the policy trained, episodes seen,
         and the success rate and mean stop error of the last 50 training episodes.
+
+    Raises
+    ------
+    ValueError
+        A bad name, a folder that holds a run (without ``resume``), or a run that cannot
+        be resumed (no ``config.json``, other settings, no checkpoint that loads).
     """
+    out = Path(out_dir)
+    _check_start(config, tensorboard_log)
+    if resume:
+        start = resume_state(out, config)
+        if start.checkpoint is None:
+            tried = "; ".join(f"{p.name}: {why}" for p, why in start.skipped)
+            raise ValueError(
+                f"{out}: no checkpoint to resume from (train with --save-freq N)"
+                if not tried
+                else f"{out}: no checkpoint loads ({tried})"
+            )
+    else:
+        check_new_run_dir(out)
+        start = _RunStart(config)
+    return _train(start, out, progress, tensorboard_log)
+
+
+def continue_run(
+    config: TrainConfig, out_dir: str | os.PathLike, progress: bool = False
+) -> dict[str, Any]:
+    """Train ``config`` in ``out_dir``, going on from what an earlier attempt of the same
+    run left there (a sweep's job run again after an interruption or a failure).
+
+    A folder without a run: a new run. A run of the same settings (its ``config.json``
+    equals ``config``, a measured goal aside): resumed from its latest checkpoint that
+    loads, or, without one, trained again from the start in the same folder (its atlases
+    and measured goal are kept). Any other run there is refused.
+
+    Raises
+    ------
+    ValueError
+        Naming the folder: it holds another run (or files of one without its
+        ``config.json``).
+    """
+    out = Path(out_dir)
+    _check_start(config, None)
+    if not run_files(out):
+        return _train(_RunStart(config), out, progress, None)
+    if not (out / "config.json").is_file():
+        raise ValueError(
+            f"{out}: holds files of a training run ({', '.join(run_files(out))}) but no "
+            "config.json: not a run of these settings; remove it or choose another --out"
+        )
+    return _train(resume_state(out, config), out, progress, None)
+
+
+def _train(
+    start: _RunStart,
+    out: Path,
+    progress: bool,
+    tensorboard_log: str | os.PathLike | None,
+) -> dict[str, Any]:
+    """The run itself (:func:`train`), once the folder is checked."""
     import torch
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import CallbackList
     from stable_baselines3.common.logger import Logger
     from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     from vc_gym.experiments.async_rollouts import AsyncRolloutPPO, AsyncSubprocVecEnv
-    from vc_gym.experiments.training_callbacks import EpisodeLog, HeldOutEvaluation
+    from vc_gym.experiments.training_callbacks import (
+        AtomicCheckpoint,
+        EpisodeLog,
+        HeldOutEvaluation,
+    )
 
-    out = Path(out_dir)
+    config, checkpoint, episodes = start.config, start.checkpoint, start.episodes
+    resume = checkpoint is not None
     algo = algorithm_class(config.algo)
-    check_names(config)  # before the run folder is made, not in the workers
-    if tensorboard_log is not None:
-        try:
-            import tensorboard  # noqa: F401
-        except ImportError:
-            raise ValueError(
-                "--tensorboard-log needs the tensorboard package: pip install tensorboard"
-            ) from None
-    episodes: list[dict[str, Any]] = []
-    checkpoint = None
     warm_start: dict[str, Any] | None = None
     offset: dict[str, Any] | None = None
-    if resume:
-        checkpoint, episodes, config = _resume_state(out, config)
     out = check_out_dir(out)
     write_json(out / "config.json", config.to_dict())
     t0 = time.perf_counter()
@@ -588,13 +879,11 @@ def train(
         venv = AsyncSubprocVecEnv(factories, start_method="forkserver")
     else:
         venv = DummyVecEnv(factories)
-    log = EpisodeLog(
-        config.timesteps,
-        episodes,
-        lambda eps: write_json(out / "train_log.json", {"running": True, "per_episode": eps}),
-        f"train {config.algo}",
-        progress,
-    )
+
+    def write_log(eps: list[dict[str, Any]]) -> None:
+        write_json(out / "train_log.json", {"running": True, "per_episode": eps})
+
+    log = EpisodeLog(config.timesteps, episodes, write_log, f"train {config.algo}", progress)
     callbacks: list[Any] = [log]
     eval_env = None
     if config.eval_freq:
@@ -615,8 +904,13 @@ def train(
         )
     if config.save_freq:
         callbacks.append(
-            CheckpointCallback(
-                max(1, config.save_freq // config.n_envs), str(out / "checkpoints"), "model"
+            AtomicCheckpoint(
+                max(1, config.save_freq // config.n_envs),
+                out / "checkpoints",
+                CHECKPOINT_PREFIX,
+                # the log of the episodes so far with each checkpoint (after it: EpisodeLog
+                # runs first), so that a run stopped here resumes with them
+                on_save=lambda: write_log(episodes),
             )
         )
     # the policy is a small MLP: one torch thread is as fast, and a second one would
@@ -665,6 +959,7 @@ def train(
         "task_steps_per_s": None if task_rate is None else round(task_rate, 2),
         "episodes": len(episodes),
         "resumed_from": None if checkpoint is None else str(checkpoint),
+        "skipped_checkpoints": [{"checkpoint": str(p), "error": why} for p, why in start.skipped],
         "warm_start": warm_start,
         "home_offset": offset,
         "best_model": str(out / "best" / "best_model.zip")
@@ -738,13 +1033,17 @@ def _algo_kwargs(config: TrainConfig) -> dict[str, Any]:
     return kwargs
 
 
-def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, Any]], TrainConfig]:
-    """The checkpoint to continue from, the episodes logged so far and the config to go
-    on with (``config`` with the run's measured ``home_offset_m``), checked first."""
+def resume_state(out: Path, config: TrainConfig) -> _RunStart:
+    """Where the run in ``out`` goes on from: the config to go on with (``config`` with
+    the run's measured ``home_offset_m``), its newest checkpoint that loads (None if
+    none does; each one skipped printed to stderr with the reason) and the episodes
+    logged up to it. The run's settings are checked first."""
     saved_path = out / "config.json"
     if not saved_path.is_file():
         raise ValueError(f"{out}: no config.json, nothing to resume")
-    saved = read_train_config(saved_path)
+    # the saved config is only compared with the caller's ``config`` and nothing is built
+    # from it, so an import path in it (the caller's own, or a mismatch) is read as a name
+    saved = read_train_config(saved_path, allow_imports=True)
     if config.home_offset_m is None:  # the run measured it: keep the measurement
         config = replace(config, home_offset_m=saved.home_offset_m)
     if replace(saved, timesteps=config.timesteps) != config:
@@ -752,19 +1051,64 @@ def _resume_state(out: Path, config: TrainConfig) -> tuple[Path, list[dict[str, 
             f"{saved_path}: the run was started with other settings; resume it with the "
             "same ones (only timesteps may change)"
         )
-    checkpoint = latest_checkpoint(out)
-    if checkpoint is None:
-        raise ValueError(f"{out}: no checkpoint to resume from (train with --save-freq N)")
-    steps = _checkpoint_steps(checkpoint)
-    log_path = out / "train_log.json"
-    episodes: list[dict[str, Any]] = []
-    if log_path.is_file():
+    skipped: list[tuple[Path, str]] = []
+    for path in checkpoints(out):
         try:
-            logged = json.loads(log_path.read_text())["per_episode"]
-        except (OSError, ValueError, KeyError, TypeError, RecursionError) as exc:
-            raise ValueError(f"{log_path}: unreadable training log: {exc}") from None
-        episodes = [e for e in logged if isinstance(e, dict) and e.get("timestep", 0) <= steps]
-    return checkpoint, episodes, config
+            load_sb3_model(config.algo, path, device="cpu")
+        except Exception as exc:  # noqa: BLE001 - whatever keeps it from loading: skip it
+            skipped.append((path, f"{type(exc).__name__}: {exc}"))
+            print(f"skipping checkpoint {path}: it does not load ({exc})", file=sys.stderr)
+            continue
+        steps = _checkpoint_steps(path)
+        assert steps is not None  # checkpoints() lists only such names
+        episodes = _read_train_log(out / "train_log.json", steps)
+        return _RunStart(config, path, episodes, skipped)
+    return _RunStart(config, None, [], skipped)
+
+
+#: The fields of one episode in ``train_log.json`` and the types each may have.
+_EPISODE_FIELDS = {
+    "timestep": numbers.Integral,
+    "return": numbers.Real,
+    "decisions": numbers.Integral,
+    "stop_error_m": numbers.Real,
+    "success": bool,
+}
+
+
+def _read_train_log(path: Path, steps: int) -> list[dict[str, Any]]:
+    """The episodes of the training log ``path`` up to ``steps`` decisions (none without
+    a log); a log larger than :data:`MAX_TRAIN_LOG_BYTES` or not of
+    :class:`~.training_callbacks.EpisodeLog`'s episodes is refused, naming the file."""
+    if not path.is_file():
+        return []
+    try:
+        with path.open("rb") as f:
+            raw = f.read(MAX_TRAIN_LOG_BYTES + 1)
+        if len(raw) > MAX_TRAIN_LOG_BYTES:
+            raise ValueError(f"larger than {MAX_TRAIN_LOG_BYTES} bytes")
+        logged = json.loads(raw.decode("utf-8"))["per_episode"]
+        if not isinstance(logged, list):
+            raise ValueError("'per_episode' is not a list")
+    except (OSError, ValueError, KeyError, TypeError, RecursionError) as exc:
+        raise ValueError(f"{path}: unreadable training log: {exc}") from None
+    episodes = []
+    for i, e in enumerate(logged):
+        if not (
+            isinstance(e, dict)
+            and set(e) == set(_EPISODE_FIELDS)
+            and all(
+                isinstance(e[k], t) and (t is bool or not isinstance(e[k], bool))
+                for k, t in _EPISODE_FIELDS.items()
+            )
+        ):
+            raise ValueError(
+                f"{path}: per_episode[{i}] is not an episode record "
+                f"({', '.join(_EPISODE_FIELDS)}): {reprlib.repr(e)}"
+            )
+        if e["timestep"] <= steps:
+            episodes.append(e)
+    return episodes
 
 
 def _plot_curve(path: Path, episodes: list[dict[str, Any]], config: TrainConfig) -> None:

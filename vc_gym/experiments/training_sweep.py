@@ -4,14 +4,17 @@ Each seed is a job: a full :func:`~vc_gym.experiments.training.train` run in its
 folder ``DIR/seed-<s>`` (the place learned with that seed, PPO seeded with it). The
 sweep's ``results.json`` holds every run's figures and their mean ± std over the seeds;
 ``run.json`` the timings. Rerunning the command resumes: finished runs are not trained
-again. Jobs run on the local pool or on Ray like every experiment; on a small machine
-one job at a time (``--workers 1``, the default here) with ``n_envs`` env workers each
-uses the cores best.
+again, and a run that was cut short goes on from its latest checkpoint (or starts over
+in its folder without one, :func:`~vc_gym.experiments.training.continue_run`); a seed
+folder holding a run of other settings is refused. Jobs run on the local pool or on Ray
+like every experiment; on a small machine one job at a time (``--workers 1``, the default
+here) with ``n_envs`` env workers each uses the cores best.
 """
 
 from __future__ import annotations
 
 import os
+import zipfile
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -20,7 +23,13 @@ from typing import Any
 import numpy as np
 
 from vc_gym.experiments.runner import ExperimentRun, Job
-from vc_gym.experiments.training import TrainConfig, read_train_config, train
+from vc_gym.experiments.training import (
+    TrainConfig,
+    continue_run,
+    read_train_config,
+    run_files,
+)
+from vc_gym.persistence import zip_entries_problem
 
 __all__ = ["FIGURES", "train_job", "run_train_sweep"]
 
@@ -34,6 +43,9 @@ FIGURES = (
     "home_offset_x_m",
     "home_offset_y_m",
 )
+#: Largest ``eval/evaluations.npz`` of a run read for the figures (bytes of its arrays
+#: together, judged before anything is decompressed).
+MAX_EVALUATIONS_BYTES = 64_000_000
 
 
 def _evaluation_figures(run_dir: Path) -> dict[str, float | None]:
@@ -46,28 +58,41 @@ def _evaluation_figures(run_dir: Path) -> dict[str, float | None]:
     }
     if not path.is_file():
         return out
-    with np.load(path, allow_pickle=False) as ev:
-        returns = np.asarray(ev["results"], dtype=np.float64).mean(axis=1)
-        out["eval_final_mean_return"] = round(float(returns[-1]), 4)
-        out["eval_best_mean_return"] = round(float(returns.max()), 4)
-        if "successes" in ev.files and ev["successes"].size:
-            out["eval_final_success_rate"] = round(float(np.mean(ev["successes"][-1])), 4)
+    try:
+        with zipfile.ZipFile(path) as z:
+            problem = zip_entries_problem(
+                z.infolist(), MAX_EVALUATIONS_BYTES, MAX_EVALUATIONS_BYTES
+            )
+        if problem is not None:
+            raise ValueError(problem)
+        with np.load(path, allow_pickle=False) as ev:
+            returns = np.asarray(ev["results"], dtype=np.float64).mean(axis=1)
+            out["eval_final_mean_return"] = round(float(returns[-1]), 4)
+            out["eval_best_mean_return"] = round(float(returns.max()), 4)
+            if "successes" in ev.files and ev["successes"].size:
+                out["eval_final_success_rate"] = round(float(np.mean(ev["successes"][-1])), 4)
+    except (OSError, ValueError, KeyError, IndexError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{path}: not a readable evaluations file: {exc}") from None
     return out
 
 
 def _goal_figures(run_dir: Path) -> dict[str, float | None]:
     """The goal correction the run measured and trained with (its ``config.json``)."""
     path = run_dir / "config.json"
-    offset = read_train_config(path).home_offset_m if path.is_file() else None
+    # only the measured goal is read from it and nothing it names is built, so a tracker
+    # given as an import path on the command line is read as a name
+    offset = read_train_config(path, allow_imports=True).home_offset_m if path.is_file() else None
     x, y = (None, None) if offset is None else offset
     return {"home_offset_x_m": x, "home_offset_y_m": y}
 
 
 def train_job(config: dict[str, Any], out_dir: str) -> dict[str, Any]:
     """Job: one full training run of ``config`` (a :meth:`TrainConfig.to_dict`) in
-    ``out_dir``; returns its figures (timings under ``"timing"``)."""
+    ``out_dir``, going on from what an earlier attempt of this job left there
+    (:func:`~vc_gym.experiments.training.continue_run`); returns its figures (timings
+    under ``"timing"``)."""
     cfg = TrainConfig.from_dict(config)
-    summary = train(cfg, out_dir, progress=False)
+    summary = continue_run(cfg, out_dir, progress=False)
     figures = {
         "episodes": summary["episodes"],
         "recent_success_rate": summary["recent_success_rate"],
@@ -110,6 +135,12 @@ def run_train_sweep(
     if not seeds or len(set(seeds)) != len(seeds) or min(seeds) < 0:
         raise ValueError(f"seeds must be distinct ints >= 0, got {seeds}")
     out = Path(out_dir)
+    if not (out / "jobs" / "settings.json").is_file() and run_files(out):
+        # a single run's folder, not a sweep's: the sweep would write beside that run
+        raise ValueError(
+            f"--out {out}: holds a training run ({', '.join(run_files(out))}), not a sweep; "
+            "choose another --out"
+        )
     settings = {"config": {**config.to_dict(), "seed": None}, "seeds": seeds}
     run = ExperimentRun(out, "train-sweep", backend, settings, progress=progress)
     jobs = [
