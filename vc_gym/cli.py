@@ -10,13 +10,37 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from vc_gym.experiments.output import write_json
+from vc_gym.validation import (
+    MAX_EPISODES,
+    MAX_HOMING_S,
+    MAX_LEARN_TIME_S,
+    MAX_SEEDS,
+    check_seed,
+    int_in_range,
+    positive_float_at_most,
+)
 
-__all__ = ["main"]
+__all__ = ["EXIT_INTERRUPTED", "MAX_BENCH_REPEATS", "MAX_VIDEOS", "main"]
+
+#: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+#: Most timed rounds of ``vc-gym bench`` (``--repeats``).
+MAX_BENCH_REPEATS = 1_000
+#: Most homing episodes written as MP4 (``--video``).
+MAX_VIDEOS = 1_000
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.demo import run_demo
+    from vc_gym.experiments.demo import check_demo_args, run_demo
 
+    # every argument, named by its flag, before the folder is made
+    check_demo_args(
+        args.seed,
+        args.learn_time,
+        tracker=args.tracker,
+        mode=args.mode,
+        names={"seed": "--seed", "learn_time_s": "--learn-time", "mode": "--mode"},
+    )
     s = run_demo(
         args.out,
         seed=args.seed,
@@ -115,10 +139,10 @@ def _cmd_train(args: argparse.Namespace) -> int:
                 f"got {sorted(unchanged)}"
             )
         out = Path(args.resume)
-        config = read_train_config(out / "config.json", **given)
+        config = read_train_config(out / "config.json", args.allow_imports, **given)
     else:
         if args.config:
-            config = read_train_config(args.config, **given)
+            config = read_train_config(args.config, args.allow_imports, **given)
         else:
             config = TrainConfig(**given)
         check_names(config)  # a bad scene or tracker fails before the folder is made
@@ -150,11 +174,38 @@ def _cmd_train(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_bench(args: argparse.Namespace) -> int:
-    if args.out:  # a bad --out fails now, not after the benchmark
-        from vc_gym.experiments.output import check_out_file
+def _check_bench_args(args: argparse.Namespace) -> None:
+    """Every ``vc-gym bench`` argument its benchmark uses, then ``--out`` and ``--plot``,
+    before any work (a bad file name fails now, not after the benchmark)."""
+    from vc_gym.experiments.output import check_out_file
 
+    int_in_range("--repeats", args.repeats, 1, MAX_BENCH_REPEATS)
+    check_seed("--seed", args.seed)
+    if args.what == "compass":
+        from vc_gym.experiments.bench_compass import MAX_FRAMES
+
+        int_in_range("--frames", args.frames, 1, MAX_FRAMES)
+    elif args.what == "backends":
+        from vc_gym.experiments.runner import check_workers
+
+        int_in_range("--episodes", args.episodes, 1, MAX_EPISODES)
+        check_workers(args.workers, "--workers", minimum=2)
+    elif args.what == "train":
+        from vc_gym.experiments.bench_train import MAX_TIMESTEPS
+        from vc_gym.experiments.runner import check_workers
+
+        int_in_range("--timesteps", args.timesteps, 1, MAX_TIMESTEPS)
+        check_workers(args.n_envs, "--n-envs")
+    if args.plot is not None and args.what != "filters":
+        raise ValueError(f"--plot is for 'bench filters', not 'bench {args.what}'")
+    if args.out:
         check_out_file(args.out)
+    if args.plot is not None:
+        check_out_file(args.plot, "--plot")
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    _check_bench_args(args)
     if args.what == "compass":
         from vc_gym.experiments.bench_compass import bench_compass
 
@@ -264,6 +315,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     size = "quick" if args.quick else (args.size or "full")
     run = experiment.runner()
     options = _experiment_options(args, run)
+    _check_experiment_args(args)  # before the folder is made and any worker starts
     with (
         new_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}") as out,
         make_backend(args.backend, args.workers, args.address) as backend,
@@ -282,9 +334,9 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     else:
         for line in experiment.summary_lines(results):
             print(line)
-        run_info = (
-            json.loads((out / "run.json").read_text()) if (out / "run.json").is_file() else {}
-        )
+        from vc_gym.experiments.output import read_json
+
+        run_info = read_json(out / "run.json") if (out / "run.json").is_file() else {}
         for line in experiment.cost_lines(run_info):
             print(line)
         print(f"wrote {out / 'results.json'}, {out / 'run.json'} and the plots in {out}")
@@ -298,6 +350,39 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
         )
         return 1
     return 0
+
+
+def _check_experiment_args(args: argparse.Namespace) -> None:
+    """The counts, seeds, times and folders ``vc-gym experiment`` (and ``evaluate``)
+    takes, by flag, with their upper bounds: checked before any work. The experiment
+    checks its own settings again (and what only it knows) before its first job."""
+    import os
+
+    from vc_gym.experiments.runner import check_workers
+
+    check_seed("--seed", args.seed)
+    if getattr(args, "workers", None) is not None:
+        check_workers(args.workers, "--workers")
+    if getattr(args, "episodes", None) is not None:
+        int_in_range("--episodes", args.episodes, 1, MAX_EPISODES)
+    seeds = getattr(args, "seeds", None)
+    if seeds is not None:
+        if not 1 <= len(seeds) <= MAX_SEEDS:
+            raise ValueError(f"--seeds must name 1..{MAX_SEEDS} seeds, got {len(seeds)}")
+        for seed in seeds:
+            check_seed("--seeds", seed)
+    if getattr(args, "video", None) is not None:
+        int_in_range("--video", args.video, 0, MAX_VIDEOS)
+    if getattr(args, "learn_time", None) is not None:
+        positive_float_at_most("--learn-time", args.learn_time, MAX_LEARN_TIME_S)
+    if getattr(args, "max_homing", None) is not None:
+        positive_float_at_most("--max-homing", args.max_homing, MAX_HOMING_S)
+    for flag, folder in (
+        ("--atlas", getattr(args, "atlas", None)),
+        ("--data", getattr(args, "data", None)),
+    ):
+        if folder is not None and not os.path.isdir(folder):
+            raise ValueError(f"{flag} {folder}: not a folder")
 
 
 def _experiment_options(args: argparse.Namespace, run) -> dict:
@@ -349,9 +434,29 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
 
 def _cmd_compass_experiment(args: argparse.Namespace) -> int:
     """The compass-only experiments (no simulator, no jobs)."""
-    from vc_gym.experiments.runner import check_out_dir
+    from vc_gym.experiments.output import new_out_dir
 
-    out = check_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}")
+    check_seed("--seed", args.seed)
+    if args.name == "real-rotation":  # the photos are checked before the folder is made
+        from vc_gym.experiments.real_data import default_real_data_dir
+
+        data = Path(args.data) if args.data else default_real_data_dir()
+        if data is None or not data.is_dir():
+            print(
+                "real photos not found: pass --data DIR (the folder holding rotation_grail/ "
+                "and rotation_parrington/) or set VC_GYM_REAL_DATA",
+                file=sys.stderr,
+            )
+            return 2
+    with new_out_dir(args.out or f"vc_gym_{args.name.replace('-', '_')}") as out:
+        result = _run_compass_experiment(args, out)
+    if args.json:
+        print(json.dumps(result))
+    return 0
+
+
+def _run_compass_experiment(args: argparse.Namespace, out: Path) -> dict:
+    """Run a compass-only experiment in ``out`` and print its table; its results."""
     if args.name == "synthetic-compass":
         from vc_gym.experiments.synthetic_compass import run_synthetic_compass
 
@@ -371,13 +476,6 @@ def _cmd_compass_experiment(args: argparse.Namespace) -> int:
         from vc_gym.experiments.real_rotation import run_real_rotation
 
         data = Path(args.data) if args.data else default_real_data_dir()
-        if data is None or not data.is_dir():
-            print(
-                "real photos not found: pass --data DIR (the folder holding rotation_grail/ "
-                "and rotation_parrington/) or set VC_GYM_REAL_DATA",
-                file=sys.stderr,
-            )
-            return 2
         result = run_real_rotation(data, progress=not args.json)
         if not args.json:
             print(
@@ -397,9 +495,7 @@ def _cmd_compass_experiment(args: argparse.Namespace) -> int:
                     )
                 print(line)
         write_json(out / "results.json", result)
-    if args.json:
-        print(json.dumps(result))
-    return 0
+    return result
 
 
 class _SceneChoices:
@@ -427,8 +523,11 @@ class _SceneChoices:
 
 def _cmd_render(args: argparse.Namespace) -> int:
     from vc_gym.envs.scenes import scene_names
+    from vc_gym.experiments.output import check_out_dir
     from vc_gym.experiments.render_scenes import render_scene_pictures
 
+    check_seed("--seed", args.seed)
+    check_out_dir(args.out)
     scenes = scene_names() if args.scene == "all" else (args.scene,)
     for path in render_scene_pictures(args.out, scenes, seed=args.seed, randomize=args.randomize):
         print(f"wrote {path}")
@@ -437,8 +536,15 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
 def _cmd_soak(args: argparse.Namespace) -> int:
     from vc_gym.experiments.output import check_out_file
-    from vc_gym.experiments.soak import soak
+    from vc_gym.experiments.soak import check_soak_args, soak
 
+    check_soak_args(
+        args.steps,
+        args.cycles,
+        args.window,
+        args.seed,
+        ("--steps", "--cycles", "--window", "--seed"),
+    )
     if args.out:
         check_out_file(args.out)
     r = soak(args.steps, args.cycles, args.window, seed=args.seed, progress=not args.json)
@@ -466,7 +572,18 @@ def _cmd_soak(args: argparse.Namespace) -> int:
 def _cmd_check(args: argparse.Namespace) -> int:
     from vc_gym.experiments.check import run_check
     from vc_gym.experiments.output import check_out_file
+    from vc_gym.experiments.soak import MAX_SOAK_STEPS, MIN_WINDOW, check_soak_args
 
+    # the soak's arguments before the cases run; its window is the one run_check uses
+    steps = int_in_range("--soak-steps", args.soak_steps, 2 * MIN_WINDOW, MAX_SOAK_STEPS)
+    window = max(MIN_WINDOW, steps // 4)
+    check_soak_args(
+        steps,
+        args.soak_cycles,
+        window,
+        0,
+        ("--soak-steps", "--soak-cycles", "--soak-steps / 4", "seed"),
+    )
     if args.out:
         check_out_file(args.out)
     r = run_check(args.soak_steps, args.soak_cycles, progress=not args.json)
@@ -745,9 +862,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tracker",
-        metavar="NAME",
-        help="tracker of the agent's env: grid (the paper's filters, default), particle or kalman",
+        type=_tracker_spec,
+        metavar="SPEC",
+        help="tracker of the agent's env: grid (the paper's filters, default), particle, "
+        "kalman, 'package.module:factory', or a JSON object such as "
+        '\'{"type": "particle", "n_particles": 500}\'',
     )
+    _add_allow_imports_option(p, "--config FILE and a --resume run's config.json")
     p.add_argument(
         "--collector",
         choices=["lockstep", "async"],
@@ -1058,12 +1179,41 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
+        print(f"vc-gym {args.command}: interrupted{_resume_hint(args)}", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except (ValueError, FileNotFoundError) as e:
         print(f"vc-gym {args.command}: error: {e}", file=sys.stderr)
         return 2
     except RuntimeError as e:  # a failure during the work (a dead worker, a fall, ...)
         print(f"vc-gym {args.command}: failed: {e}", file=sys.stderr)
         return 1
+
+
+def _resume_hint(args: argparse.Namespace) -> str:
+    """How to go on after Ctrl-C, where a command can: ``"; ..."`` or ``""``."""
+    command = args.command
+    if command in ("experiment", "evaluate"):
+        name = getattr(args, "name", "homing")
+        if name in ("synthetic-compass", "real-rotation"):
+            return ""  # no jobs: it starts over
+        out = args.out or f"vc_gym_{name.replace('-', '_')}"
+        return f"; rerun the same command to resume from the jobs saved in {out}"
+    if command == "train":
+        if getattr(args, "seeds", None) is not None:
+            out = args.out or "vc_gym_agent"
+            return f"; rerun the same command to resume the sweep from the runs saved in {out}"
+        out = args.resume or args.out or "vc_gym_agent"
+        try:
+            from vc_gym.experiments.training import latest_checkpoint
+
+            saved = latest_checkpoint(out) is not None
+        except Exception:  # noqa: BLE001 - only a hint; the run is over either way
+            saved = False
+        if saved:
+            return f"; 'vc-gym train --resume {out}' continues from its last checkpoint"
+        return "; no checkpoint was saved to resume from (--save-freq N saves them)"
+    return ""
 
 
 if __name__ == "__main__":  # pragma: no cover

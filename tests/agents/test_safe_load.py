@@ -217,3 +217,24 @@ def test_a_sac_agent_loads_and_its_network_is_checked(tmp_path):
     )
     with pytest.raises(UnsafeModelError, match="do not match"):
         load_sb3_model("sac", bad)
+
+
+@pytest.mark.parametrize("entry", ["policy.pth", "policy.optimizer.pth", "pytorch_variables.pth"])
+def test_a_pickled_tensor_file_is_refused_without_suggesting_to_unpickle(tmp_path, entry):
+    marker = tmp_path / "ran"
+    bad = tmp_path / "model.zip"
+    with zipfile.ZipFile(PRETRAINED_MODEL) as zin, zipfile.ZipFile(bad, "w") as zout:
+        for info in zin.infolist():
+            content = zin.read(info)
+            if info.filename == entry:
+                import io
+
+                import torch
+
+                buf = io.BytesIO()
+                torch.save({"x": _Payload(marker)}, buf)
+                content = buf.getvalue()
+            zout.writestr(info.filename, content)
+    with pytest.raises(UnsafeModelError, match="cannot be loaded safely") as err:
+        load_sb3_model("ppo", bad)
+    assert "weights_only" not in str(err.value) and not marker.exists()

@@ -300,16 +300,32 @@ def _expected_shapes(algo: str, arch: dict[str, list[int]], n_obs: int, n_act: i
     return shapes
 
 
-def _weight_shapes(path: Path) -> dict[str, tuple[int, ...]]:
-    """The shape of every tensor in the zip's ``policy.pth`` (``weights_only``: no code)."""
+def _tensor_files(path: Path) -> dict[str, Any]:
+    """Every ``.pth`` entry of the zip, read with ``torch.load(weights_only=True)``: no
+    code runs, and a file that is not plain tensors and numbers is refused here, in our
+    words (torch's own message would suggest ``weights_only=False``, which runs code)."""
     import torch
 
-    with zipfile.ZipFile(path) as z:
-        raw = z.read("policy.pth")
+    loaded: dict[str, Any] = {}
     try:
-        state = torch.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
-    except Exception as exc:  # noqa: BLE001 - torch raises many kinds on a bad file
-        raise UnsafeModelError(f"'policy.pth' is not a readable tensor file: {exc}") from None
+        with zipfile.ZipFile(path) as z:
+            raws = {n: z.read(n) for n in z.namelist() if n.endswith(".pth")}
+    except Exception as exc:  # noqa: BLE001 - a bad CRC, a broken deflate stream, ...
+        raise UnsafeModelError(f"its tensor files cannot be read: {exc}") from None
+    for name, raw in raws.items():
+        try:
+            loaded[name] = torch.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
+        except Exception as exc:  # noqa: BLE001 - torch raises many kinds on a bad file
+            raise UnsafeModelError(
+                f"{name!r} is not plain tensors and cannot be loaded safely "
+                f"({type(exc).__name__})"
+            ) from None
+    return loaded
+
+
+def _weight_shapes(path: Path) -> dict[str, tuple[int, ...]]:
+    """The shape of every tensor in the zip's ``policy.pth`` (see :func:`_tensor_files`)."""
+    state = _tensor_files(path).get("policy.pth")
     if not isinstance(state, dict) or not all(hasattr(v, "shape") for v in state.values()):
         raise UnsafeModelError("'policy.pth' is not a dict of tensors")
     return {str(k): tuple(v.shape) for k, v in state.items()}

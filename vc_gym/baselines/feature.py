@@ -21,12 +21,16 @@ from vc_gym.baselines.base import BaselineCompass, FrameScore, check_camera
 from vc_gym.compass import Camera
 from vc_gym.errors import NotLearnedError
 from vc_gym.images import check_image
-from vc_gym.validation import int_at_least, positive_float
+from vc_gym.validation import int_at_least, int_in_range, positive_float
 
 __all__ = ["FeatureCompass", "keypoint_directions"]
 
 #: Bytes of an ORB descriptor.
 DESCRIPTOR_BYTES = 32
+#: Most keypoints ORB looks for in a frame, and most a learned map keeps (64 MB of
+#: descriptors at the most).
+MAX_FEATURES = 100_000
+MAX_KEYPOINTS = 2_000_000
 # OpenCV allocates a pyramid per level and a border of the patch size: beyond these a
 # sensor file's parameters would ask it for gigabytes (10**6 levels: an allocation error)
 _MAX_LEVELS = 32
@@ -196,7 +200,7 @@ class FeatureCompass(BaselineCompass):
         heading_step_deg: float = 1.0,
     ):
         super().__init__(heading_step_deg)
-        self.n_features = int_at_least("n_features", n_features, 1)
+        self.n_features = int_in_range("n_features", n_features, 1, MAX_FEATURES)
         self.fast_threshold = int_at_least("fast_threshold", fast_threshold, 1)
         if self.fast_threshold > 254:
             raise ValueError(f"fast_threshold must be <= 254, got {fast_threshold}")
@@ -221,7 +225,7 @@ class FeatureCompass(BaselineCompass):
         self.max_elevation_diff_deg = positive_float(
             "max_elevation_diff_deg", max_elevation_diff_deg
         )
-        self.max_keypoints = int_at_least("max_keypoints", max_keypoints, 1)
+        self.max_keypoints = int_in_range("max_keypoints", max_keypoints, 1, MAX_KEYPOINTS)
         self.seed = int_at_least("seed", seed, 0)
         self._orb = self._make_orb()
         self._kappa = 1.0 / math.radians(self.sigma_deg) ** 2

@@ -19,12 +19,14 @@ from vc_gym.angles import wrap360
 from vc_gym.baselines.base import BaselineCompass, FrameScore
 from vc_gym.baselines.strip import StripGrid, angular_strip, strip_offsets
 from vc_gym.compass import Camera
-from vc_gym.validation import finite_real, positive_float
+from vc_gym.validation import finite_real, positive_float, positive_float_at_most
 
 __all__ = ["ImageDifferenceCompass", "NORMALIZATIONS"]
 
 #: Photometric normalisations of a strip (see :class:`ImageDifferenceCompass`).
 NORMALIZATIONS = ("mean", "none", "local")
+#: Largest noise (a multiple of the learned panorama's mean level).
+MAX_NOISE_STD = 1e3
 #: A mean intensity below this many grey levels is black: it is not divided by.
 _DARK = 1e-3
 # Rows of the per-row spectra stack: m, m |v|^2, m v_r, m v_g, m v_b (v = q or P).
@@ -147,7 +149,8 @@ class ImageDifferenceCompass(BaselineCompass):
         if not isinstance(normalize, str) or normalize not in NORMALIZATIONS:
             raise ValueError(f"normalize must be one of {NORMALIZATIONS}, got {normalize!r}")
         self.normalize = normalize
-        self.noise_std = positive_float("noise_std", noise_std)
+        # bounded: a saved sensor's noise of 1e300 would flatten every likelihood silently
+        self.noise_std = positive_float_at_most("noise_std", noise_std, MAX_NOISE_STD)
         overlap = finite_real("min_overlap", min_overlap)
         if not 0.0 < overlap <= 1.0:
             raise ValueError(f"min_overlap must be in (0, 1], got {min_overlap!r}")

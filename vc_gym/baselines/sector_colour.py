@@ -21,7 +21,12 @@ from vc_gym.angles import steps_in_circle
 from vc_gym.baselines.base import BaselineCompass, FrameScore
 from vc_gym.baselines.strip import StripGrid, angular_strip, strip_offsets
 from vc_gym.compass import Camera
-from vc_gym.validation import int_at_least, nonnegative_float, positive_float
+from vc_gym.validation import (
+    int_in_range,
+    nonnegative_float,
+    positive_float,
+    positive_float_at_most,
+)
 
 __all__ = ["SectorColourCompass", "FEATURES", "MODELS"]
 
@@ -29,6 +34,15 @@ __all__ = ["SectorColourCompass", "FEATURES", "MODELS"]
 FEATURES = ("chroma", "rgb")
 #: Per-sector models of the features.
 MODELS = ("gaussian", "histogram")
+#: Largest feature spread (``min_sigma``, ``prior_sigma``, ``gain_sigma``): the features
+#: are chromaticities and levels within about [0, 1].
+MAX_SIGMA = 10.0
+#: Largest weight of the prior's pseudo-observations, temperature, smoothing and
+#: histogram bins a sensor may have.
+MAX_PRIOR_WEIGHT = 1e6
+MAX_TEMPERATURE = 1e3
+MAX_SMOOTHING = 1e4
+MAX_BINS = 1024
 
 #: Linear-light offset added before taking logs (about sRGB code 6): keeps the
 #: log-colour of near-black sectors finite and stops their noise from dominating.
@@ -219,13 +233,23 @@ class SectorColourCompass(BaselineCompass):
         if frac > 1.0:
             raise ValueError(f"min_valid_fraction must be in (0, 1], got {frac}")
         self.min_valid_fraction = frac
-        self.min_sigma = positive_float("min_sigma", min_sigma)
-        self.prior_sigma = positive_float("prior_sigma", prior_sigma)
+        # upper bounds too: a saved sensor's settings pass these checks, and a sigma or a
+        # temperature of 1e300 would flatten every likelihood without a word
+        self.min_sigma = positive_float_at_most("min_sigma", min_sigma, MAX_SIGMA)
+        self.prior_sigma = positive_float_at_most("prior_sigma", prior_sigma, MAX_SIGMA)
         self.prior_weight = nonnegative_float("prior_weight", prior_weight)
-        self.n_bins = int_at_least("n_bins", n_bins, 2)
-        self.smoothing = positive_float("smoothing", smoothing)
-        self.temperature = positive_float("temperature", temperature)
-        self.gain_sigma = None if gain_sigma is None else positive_float("gain_sigma", gain_sigma)
+        if self.prior_weight > MAX_PRIOR_WEIGHT:
+            raise ValueError(
+                f"prior_weight must be in [0, {MAX_PRIOR_WEIGHT:g}], got {prior_weight!r}"
+            )
+        self.n_bins = int_in_range("n_bins", n_bins, 2, MAX_BINS)
+        self.smoothing = positive_float_at_most("smoothing", smoothing, MAX_SMOOTHING)
+        self.temperature = positive_float_at_most("temperature", temperature, MAX_TEMPERATURE)
+        self.gain_sigma = (
+            None
+            if gain_sigma is None
+            else positive_float_at_most("gain_sigma", gain_sigma, MAX_SIGMA)
+        )
         d, b = _N_FEATURES, self.n_bins
         self._count = np.zeros(self.n_sectors, dtype=np.float64)
         if model == "gaussian":

@@ -18,7 +18,7 @@ from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
 from vc_gym.envs.scenes import Scene, build_scene, check_scene_name
 from vc_gym.envs.top_view import TopView
 from vc_gym.poses import check_pose
-from vc_gym.validation import positive_float
+from vc_gym.validation import check_action, check_reset_options, positive_float
 
 __all__ = ["AiboRoomEnv", "MAX_ILLUMINATION", "ROBOT_CLEARANCE_M"]
 
@@ -26,6 +26,9 @@ __all__ = ["AiboRoomEnv", "MAX_ILLUMINATION", "ROBOT_CLEARANCE_M"]
 MAX_ILLUMINATION = 4.0
 #: A placed robot's centre keeps this far inside the room's walls.
 ROBOT_CLEARANCE_M = 0.1
+
+#: The ``reset`` options the room takes.
+RESET_OPTIONS = ("pose",)
 
 #: Bounds of the odometry observation (m, m, degrees): far beyond one step's motion.
 _ODO_LIMIT = np.array([5.0, 5.0, 720.0], np.float32)
@@ -50,7 +53,8 @@ class AiboRoomEnv(gym.Env):
     fractions of their maxima (0.5 m/s, 0.2 m/s, 86°/s), then the head pan and tilt
     targets as fractions of their ranges (pan ±90°, positive left; tilt from -45° to
     30°, positive up: -1 is -45°, 0 is level, 1 is 30°). Actions outside [-1, 1] are
-    clipped; NaN is an error.
+    clipped; anything but a finite real numeric array of shape ``(5,)`` (NaN, a
+    complex, string or object array, a dict) is a ``ValueError``.
 
     ## Observation Space
 
@@ -250,11 +254,8 @@ class AiboRoomEnv(gym.Env):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         self._check_open()
+        options = check_reset_options(options, RESET_OPTIONS)
         super().reset(seed=seed)
-        options = dict(options or {})
-        unknown = set(options) - {"pose"}
-        if unknown:
-            raise ValueError(f"unknown reset options {sorted(unknown)}; known: ['pose']")
         if self._bc is not None and not self._bc.isConnected():
             # the physics server is gone (killed, or disconnected by hand): start a new one
             # and rebuild the world in it, as a fresh env would
@@ -304,12 +305,7 @@ class AiboRoomEnv(gym.Env):
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         self._check_open()
         robot = self.robot
-        a = np.asarray(action, dtype=np.float64)
-        if a.shape != (5,):
-            raise ValueError(f"action must have shape (5,), got {a.shape}")
-        if not np.all(np.isfinite(a)):
-            raise ValueError(f"action must be finite, got {action!r}")
-        a = np.clip(a, -1.0, 1.0)
+        a = np.clip(check_action(action, self.action_space.shape), -1.0, 1.0)
         pan_lo, pan_hi = robot.pan_limits
         tilt_lo, tilt_hi = robot.tilt_limits
         tilt = a[4] * (tilt_hi if a[4] >= 0 else -tilt_lo)

@@ -19,7 +19,13 @@ from gymnasium import spaces
 from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.localization import TrackerSpec
-from vc_gym.validation import finite_real, flag, nonnegative_float, positive_float
+from vc_gym.validation import (
+    check_action,
+    finite_real,
+    flag,
+    nonnegative_float,
+    positive_float,
+)
 
 __all__ = [
     "MAX_HOME_OFFSET_M",
@@ -238,10 +244,7 @@ class StopAction(gym.Wrapper):
         return a
 
     def step(self, action):
-        a = np.asarray(action, dtype=np.float64)
-        if a.shape != (3,) or not np.all(np.isfinite(a)):
-            raise ValueError(f"action must be 3 finite numbers, got {action!r}")
-        a = np.clip(a, -1.0, 1.0)
+        a = np.clip(check_action(action, self.action_space.shape), -1.0, 1.0)
         self._t += 1
         walking = self._t <= self.min_walk_steps or self._walked_m < self.min_walk_m
         if a[2] <= STOP_THRESHOLD or walking:
@@ -298,9 +301,10 @@ class PreviousAction(gym.Wrapper):
         return self._with(obs, np.zeros(self.WIDTH)), info
 
     def step(self, action):
-        obs, r, terminated, truncated, info = self.env.step(action)  # checks the action
+        a = check_action(action, self.action_space.shape)  # before the step, not after
+        obs, r, terminated, truncated, info = self.env.step(action)
         return (
-            self._with(obs, np.clip(np.asarray(action, np.float64), -1.0, 1.0)),
+            self._with(obs, np.clip(a, -1.0, 1.0)),
             r,
             terminated,
             truncated,

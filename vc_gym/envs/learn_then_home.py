@@ -13,7 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.envs.aibo_room import AiboRoomEnv
+from vc_gym.envs.aibo_room import RESET_OPTIONS, AiboRoomEnv
 from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.envs.learning import (
     HOME,
@@ -26,7 +26,13 @@ from vc_gym.envs.learning import (
     paper_spots,
 )
 from vc_gym.poses import compose
-from vc_gym.validation import int_at_least, nonnegative_float, positive_float
+from vc_gym.validation import (
+    check_action,
+    check_reset_options,
+    int_at_least,
+    nonnegative_float,
+    positive_float,
+)
 
 __all__ = ["LearnThenHomeEnv", "LEARNING_MODES"]
 
@@ -317,11 +323,8 @@ class LearnThenHomeEnv(gym.Env):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         self.room._check_open()
+        options = check_reset_options(options, RESET_OPTIONS)
         super().reset(seed=seed)
-        options = dict(options or {})
-        unknown = set(options) - {"pose"}
-        if unknown:
-            raise ValueError(f"unknown reset options {sorted(unknown)}; known: ['pose']")
         room_seed = int(self.np_random.integers(2**31))
         self._still_steps = 0
         self._phase_time = 0.0
@@ -370,12 +373,7 @@ class LearnThenHomeEnv(gym.Env):
         if self._phase is None:
             self.room._check_open()
             raise RuntimeError("call reset() before step() (the episode has ended or not begun)")
-        a = np.asarray(action, dtype=np.float64)
-        if a.shape != self.action_space.shape:
-            raise ValueError(f"action must have shape {self.action_space.shape}, got {a.shape}")
-        if not np.all(np.isfinite(a)):
-            raise ValueError(f"action must be finite, got {action!r}")
-        a = np.clip(a, -1.0, 1.0)
+        a = np.clip(check_action(action, self.action_space.shape), -1.0, 1.0)
         if self._phase == "learning":
             return self._learning_step(a)
         obs, _, fell, _, info = self.room.step(a[:5])

@@ -8,11 +8,14 @@ in every place.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
+
+from vc_gym.validation import check_action
 
 __all__ = ["PlacePool"]
 
@@ -35,7 +38,10 @@ class PlacePool(gym.Env):
     Raises
     ------
     ValueError
-        On an empty pool, something that is not an env, or spaces that differ.
+        On an empty pool, something that is not an env, or spaces that differ; from
+        ``reset``, for ``options`` that are not a dict (the place's env checks their
+        keys); from ``step``, for an action that is not a finite real array of a
+        ``Box`` action space's shape.
     """
 
     def __init__(self, envs: Sequence[gym.Env]):
@@ -64,6 +70,12 @@ class PlacePool(gym.Env):
     ) -> tuple[Any, dict[str, Any]]:
         if self._closed:
             raise RuntimeError("this PlacePool is closed")
+        if options is not None and not isinstance(options, Mapping):
+            # refused before a place is drawn; the place's env checks the keys
+            raise ValueError(
+                f"reset options must be a dict (or None), got {type(options).__name__}: "
+                f"{options!r:.80}"
+            )
         super().reset(seed=seed)
         self.place = int(self.np_random.integers(len(self.envs)))
         episode_seed = int(self.np_random.integers(2**31))
@@ -75,6 +87,8 @@ class PlacePool(gym.Env):
             raise RuntimeError("this PlacePool is closed")
         if self.place is None:
             raise RuntimeError("call reset() before step()")
+        if isinstance(self.action_space, spaces.Box):
+            check_action(action, self.action_space.shape)  # the place's env may not check
         obs, reward, terminated, truncated, info = self.envs[self.place].step(action)
         return obs, reward, terminated, truncated, {**info, "place": self.place}
 

@@ -11,15 +11,15 @@ ratios to one local worker, and whether every backend wrote byte-identical
 from __future__ import annotations
 
 import importlib.util
-import json
 import tempfile
 from pathlib import Path
 from typing import Any
 
-from vc_gym.experiments.runner import LocalBackend, RayBackend
+from vc_gym.experiments.output import read_json
+from vc_gym.experiments.runner import LocalBackend, RayBackend, check_workers
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.homing import run_homing
-from vc_gym.validation import int_at_least, positive_float
+from vc_gym.validation import MAX_EPISODES, check_seed, int_in_range, positive_float
 
 __all__ = ["bench_backends"]
 
@@ -37,9 +37,11 @@ def bench_backends(
     Parameters
     ----------
     episodes : int
-        Kidnappings (jobs) per backend; the same ones on every backend.
+        Kidnappings (jobs) per backend; the same ones on every backend (1 to
+        :data:`~vc_gym.validation.MAX_EPISODES`).
     workers : int
-        Workers of the parallel backends (this machine: 2 cores).
+        Workers of the parallel backends (2 to
+        :func:`~vc_gym.experiments.runner.max_workers`).
     seed : int
         Learning seed (the atlas is learned once, before any timing).
     learn_time_s, max_homing_s : float
@@ -53,8 +55,9 @@ def bench_backends(
         ``{"runs": {name: {"jobs_per_s", "wall_s", ...}}, "speedup": {name: ratio},
         "identical_results": bool, ...}``.
     """
-    int_at_least("episodes", episodes, 1)
-    int_at_least("workers", workers, 2)
+    int_in_range("episodes", episodes, 1, MAX_EPISODES)
+    check_workers(workers, "workers", minimum=2)
+    check_seed("seed", seed)
     positive_float("learn_time_s", learn_time_s)
     positive_float("max_homing_s", max_homing_s)
     backends: list[tuple[str, Any]] = [
@@ -79,7 +82,7 @@ def bench_backends(
                     seed=seed, backend=backend, atlas_dir=atlases, progress=progress
                 )
                 run_homing(root / name, opts, field=False, **task)
-            stage = json.loads((root / name / "run.json").read_text())["stages"]["episodes"]
+            stage = read_json(root / name / "run.json")["stages"]["episodes"]
             runs[name] = {
                 "jobs": stage["jobs"],
                 "jobs_per_s": stage["jobs_per_s"],

@@ -14,9 +14,17 @@ from collections.abc import Callable
 import numpy as np
 
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
+from vc_gym.validation import check_seed, int_in_range
 from vc_gym.worlds.panorama import make_panorama, render_view
 
-__all__ = ["bench_compass"]
+__all__ = ["MAX_FRAMES", "MAX_INNER", "MAX_REPEATS", "bench_compass"]
+
+#: Most distinct test frames (each is rendered and kept in memory, ~100 KB).
+MAX_FRAMES = 1_000
+#: Most timed rounds.
+MAX_REPEATS = 1_000
+#: Most calls per timing sample.
+MAX_INNER = 10_000
 
 #: Figures the paper reports for the Sony Aibo (section 5.3), milliseconds per frame.
 PAPER_LEARN_MS = 4.0
@@ -43,11 +51,14 @@ def bench_compass(
     Parameters
     ----------
     frames : int
-        Distinct test frames (random yaws in a synthetic room).
+        Distinct test frames (random yaws in a synthetic room), 1 to
+        :data:`MAX_FRAMES`.
     repeats : int
-        Timed rounds; each round times every frame once per quantity.
+        Timed rounds; each round times every frame once per quantity (1 to
+        :data:`MAX_REPEATS`).
     inner : int
-        Calls per timing sample (divides timer overhead away).
+        Calls per timing sample (divides timer overhead away; 1 to
+        :data:`MAX_INNER`).
     config : CompassConfig, optional
         Compass parameters (default: the paper's).
     seed : int
@@ -62,8 +73,10 @@ def bench_compass(
         scanned pixels once), ``pixels_per_s`` (scanned pixels localised per second),
         the ratios to the floor, the paper's Aibo figures and run details.
     """
-    if frames < 1 or repeats < 1 or inner < 1:
-        raise ValueError("frames, repeats and inner must be >= 1")
+    int_in_range("frames", frames, 1, MAX_FRAMES)
+    int_in_range("repeats", repeats, 1, MAX_REPEATS)
+    int_in_range("inner", inner, 1, MAX_INNER)
+    check_seed("seed", seed)
     rng = np.random.default_rng(seed)
     cfg = config if config is not None else CompassConfig()
     width, height = AIBO_RESOLUTION

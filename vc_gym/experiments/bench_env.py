@@ -22,10 +22,15 @@ import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.envs.head_camera import HeadCameraSpec
 from vc_gym.envs.robot import Quadruped
 from vc_gym.envs.scenes import build_scene, check_scene_name
+from vc_gym.validation import check_seed, flag, int_in_range
 
 __all__ = ["bench_env"]
 
 ENV_ID = "vc_gym/AiboRoom-v0"
+#: Most steps per timed round.
+MAX_STEPS = 100_000
+#: Most timed rounds.
+MAX_ROUNDS = 1_000
 
 
 def _env_rate(env: gym.Env, actions: np.ndarray) -> float:
@@ -83,9 +88,9 @@ def bench_env(
     Parameters
     ----------
     steps : int
-        Steps per timed round.
+        Steps per timed round (1 to :data:`MAX_STEPS`).
     rounds : int
-        Alternating env / bare rounds (medians are reported).
+        Alternating env / bare rounds (medians are reported; 1 to :data:`MAX_ROUNDS`).
     seed : int
         Seed of actions and env.
     scene : str
@@ -95,8 +100,10 @@ def bench_env(
     vector : bool
         Also measure 2-env sync and async vector envs.
     """
-    if steps < 1 or rounds < 1:
-        raise ValueError("steps and rounds must be >= 1")
+    int_in_range("steps", steps, 1, MAX_STEPS)
+    int_in_range("rounds", rounds, 1, MAX_ROUNDS)
+    check_seed("seed", seed)
+    flag("vector", vector)
     check_scene_name(scene)
     rng = np.random.default_rng(seed)
     env = gym.make(ENV_ID, scene=scene)

@@ -33,11 +33,16 @@ from vc_gym.filters.particle import ParticleFilter
 from vc_gym.filters.sensors import VonMisesHeadingSensor
 from vc_gym.filters.translational import TranslationalFilter
 from vc_gym.localization import CompassHeadingSensor
+from vc_gym.validation import check_seed, int_in_range
 from vc_gym.worlds.room import make_room, render_room_view
 
 __all__ = ["bench_filters", "tracking_run"]
 
 DT_S = 1.0 / 30.0
+#: Most timed rounds of the cost benchmark.
+MAX_REPEATS = 1_000
+#: Fewest and most steps of the tracking run.
+MIN_STEPS, MAX_STEPS = 8, 100_000
 FIELD = (-3.0, 3.0, -2.0, 2.0)
 
 
@@ -185,9 +190,19 @@ def tracking_run(steps: int = 240, seed: int = 0, occlusion_prob: float = 0.15) 
 def bench_filters(
     repeats: int = 30, steps: int = 240, seed: int = 0, plot: str | os.PathLike | None = None
 ) -> dict[str, object]:
-    """Run the cost and the tracking benchmarks; optionally save a PNG of the run."""
-    if repeats < 1 or steps < 8:
-        raise ValueError("repeats must be >= 1 and steps >= 8")
+    """Run the cost and the tracking benchmarks; optionally save a PNG of the run.
+
+    ``repeats`` (1 to :data:`MAX_REPEATS`), ``steps`` (:data:`MIN_STEPS` to
+    :data:`MAX_STEPS`), ``seed`` and ``plot`` (a writable file) are checked before any
+    work.
+    """
+    int_in_range("repeats", repeats, 1, MAX_REPEATS)
+    int_in_range("steps", steps, MIN_STEPS, MAX_STEPS)
+    check_seed("seed", seed)
+    if plot is not None:
+        from vc_gym.experiments.output import check_out_file
+
+        check_out_file(plot, "plot")
     cost = _cost(repeats, seed)
     track = tracking_run(steps, seed)
     summary = {

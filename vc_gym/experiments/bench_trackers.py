@@ -21,12 +21,17 @@ from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.localization import TRACKERS, make_tracker
 from vc_gym.poses import compose
+from vc_gym.validation import check_seed, int_in_range
 from vc_gym.worlds.room import make_room, render_room_view
 
 __all__ = ["bench_trackers"]
 
 SPOTS = {"east": (1.0, 0.0), "north": (0.0, 1.0), "west": (-1.0, 0.0), "south": (0.0, -1.0)}
 PANS = (-22.5, 0.0, 22.5)
+#: Most frames of the walk (each is rendered and kept in memory).
+MAX_FRAMES = 10_000
+#: Most rounds.
+MAX_REPEATS = 1_000
 
 
 def _atlas(room) -> CompassAtlas:
@@ -69,9 +74,10 @@ def bench_trackers(
     Parameters
     ----------
     frames : int
-        Frames of the walk (each round runs every tracker over all of them).
+        Frames of the walk (each round runs every tracker over all of them; 1 to
+        :data:`MAX_FRAMES`).
     repeats : int
-        Rounds (medians over rounds x frames).
+        Rounds (medians over rounds x frames; 1 to :data:`MAX_REPEATS`).
     seed : int
         Seed of the room and the walk.
     progress : bool
@@ -83,8 +89,9 @@ def bench_trackers(
         ``{"atlas_ms": ..., "trackers": {name: {"update_ms", "overhead_ms",
         "final_heading_error_deg", "final_position_error_m"}}, ...}``.
     """
-    if frames < 1 or repeats < 1:
-        raise ValueError("frames and repeats must be >= 1")
+    int_in_range("frames", frames, 1, MAX_FRAMES)
+    int_in_range("repeats", repeats, 1, MAX_REPEATS)
+    check_seed("seed", seed)
     rng = np.random.default_rng(seed)
     room = make_room(rng)
     atlas = _atlas(room)

@@ -17,12 +17,25 @@ import numpy as np
 
 from vc_gym.envs.learning import LearningResult, ScriptedLearning
 from vc_gym.envs.top_view import TopView
-from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
-from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
+from vc_gym.experiments.episode import (
+    HOMING_MODES,
+    EpisodeRecord,
+    make_homing_run,
+    run_episode,
+)
+from vc_gym.experiments.output import new_figure, new_out_dir, save_figure, write_json
 from vc_gym.localization import TrackerSpec, make_tracker
-from vc_gym.validation import positive_float
+from vc_gym.validation import (
+    MAX_HOMING_S,
+    MAX_LEARN_TIME_S,
+    MAX_SEED,
+    flag,
+    int_in_range,
+    positive_float,
+    positive_float_at_most,
+)
 
-__all__ = ["run_demo"]
+__all__ = ["check_demo_args", "run_demo"]
 
 
 def run_demo(
@@ -44,17 +57,20 @@ def run_demo(
     Parameters
     ----------
     out_dir : path-like
-        Where ``summary.json`` and ``demo.png`` go.
+        Where ``summary.json`` and ``demo.png`` go (created only once every argument
+        has been checked, and removed again if the run fails before writing them).
     seed : int
-        Seed of the learning phase; the kidnapping uses ``seed + 1``.
+        Seed of the learning phase, ``0..MAX_SEED - 1``; the kidnapping uses
+        ``seed + 1``.
     learn_time_s : float
-        Learning time per direction (paper: 5 s).
+        Learning time per direction (paper: 5 s; at most
+        :data:`~vc_gym.validation.MAX_LEARN_TIME_S`).
     success_radius_m : float
         The episode succeeds if the robot stops within this distance of home.
     tracker : str, dict or callable
         The tracker (:func:`vc_gym.localization.make_tracker`), default the paper's.
     max_homing_s : float
-        Homing time limit.
+        Homing time limit (at most :data:`~vc_gym.validation.MAX_HOMING_S`).
     progress : bool
         Progress bars per phase.
     mode : str
@@ -67,43 +83,85 @@ def run_demo(
     -------
     dict
         The summary also written to ``summary.json``.
+
+    Raises
+    ------
+    ValueError
+        For any argument out of range, before the folder is made or anything is run.
     """
-    positive_float("learn_time_s", learn_time_s)
-    positive_float("success_radius_m", success_radius_m)
-    positive_float("max_homing_s", max_homing_s)
-    make_tracker(tracker)  # fail before any work
-    out = check_out_dir(out_dir)
-    t0 = time.perf_counter()
-    run = make_homing_run(
-        "scripted",
-        tracker=tracker,
-        learn_time_s=learn_time_s,
-        success_radius_m=success_radius_m,
-        max_homing_s=max_homing_s,
-        learner=ScriptedLearning(progress=progress),
-        mode=mode,
-    )
-    try:
-        run.env.reset(seed=seed)  # the learning phase
-        record = run_episode(run, seed=seed + 1, progress=progress)
-        u = run.env.unwrapped
-        learned = u.learning_result
-        summary = {
-            "task": "learn 4 spots 1 m around home, kidnapping, homing (scripted)",
-            "scene": "robolab",
-            "tracker": tracker if isinstance(tracker, str) else "custom",
-            "learning_seed": seed,
-            "mode": mode,
-            **record.summary(),
-            "success_radius_m": success_radius_m,
-            "odometry_turn_calibration": learned.odometry_turn_scale,
-        }
-        _plot(out / "demo.png", record, learned, TopView(u.room.client, u.room.scene))
-    finally:
-        run.close()
-    summary["duration_s"] = round(time.perf_counter() - t0, 1)
-    write_json(out / "summary.json", summary)
+    check_demo_args(seed, learn_time_s, success_radius_m, tracker, max_homing_s, progress, mode)
+    with new_out_dir(out_dir) as out:
+        t0 = time.perf_counter()
+        run = make_homing_run(
+            "scripted",
+            tracker=tracker,
+            learn_time_s=learn_time_s,
+            success_radius_m=success_radius_m,
+            max_homing_s=max_homing_s,
+            learner=ScriptedLearning(progress=progress),
+            mode=mode,
+        )
+        try:
+            run.env.reset(seed=seed)  # the learning phase
+            record = run_episode(run, seed=seed + 1, progress=progress)
+            u = run.env.unwrapped
+            learned = u.learning_result
+            summary = {
+                "task": "learn 4 spots 1 m around home, kidnapping, homing (scripted)",
+                "scene": "robolab",
+                "tracker": tracker if isinstance(tracker, str) else "custom",
+                "learning_seed": seed,
+                "mode": mode,
+                **record.summary(),
+                "success_radius_m": success_radius_m,
+                "odometry_turn_calibration": learned.odometry_turn_scale,
+            }
+            _plot(out / "demo.png", record, learned, TopView(u.room.client, u.room.scene))
+        finally:
+            run.close()
+        summary["duration_s"] = round(time.perf_counter() - t0, 1)
+        write_json(out / "summary.json", summary)
     return summary
+
+
+def check_demo_args(
+    seed: object = 0,
+    learn_time_s: object = 5.0,
+    success_radius_m: object = 0.3,
+    tracker: TrackerSpec = "grid",
+    max_homing_s: object = 60.0,
+    progress: object = True,
+    mode: object = "improved",
+    names: dict[str, str] | None = None,
+) -> None:
+    """Check :func:`run_demo`'s arguments before anything is made or run.
+
+    Parameters
+    ----------
+    seed, learn_time_s, success_radius_m, tracker, max_homing_s, progress, mode
+        As :func:`run_demo`.
+    names : dict, optional
+        The names to use in error messages, by argument (a command's flags, e.g.
+        ``{"seed": "--seed", "learn_time_s": "--learn-time"}``).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and its accepted range.
+    """
+    names = dict(names or {})
+
+    def name(arg: str) -> str:
+        return names.get(arg, arg)
+
+    int_in_range(name("seed"), seed, 0, MAX_SEED - 1)  # the kidnapping uses seed + 1
+    positive_float_at_most(name("learn_time_s"), learn_time_s, MAX_LEARN_TIME_S)
+    positive_float(name("success_radius_m"), success_radius_m)
+    positive_float_at_most(name("max_homing_s"), max_homing_s, MAX_HOMING_S)
+    flag(name("progress"), progress)
+    if not isinstance(mode, str) or mode not in HOMING_MODES:
+        raise ValueError(f"{name('mode')} must be one of {list(HOMING_MODES)}, got {mode!r}")
+    make_tracker(tracker)
 
 
 def _plot(path: Path, record: EpisodeRecord, learned: LearningResult, top: TopView) -> None:

@@ -3,6 +3,14 @@
 Figures are :class:`matplotlib.figure.Figure` objects made by :func:`new_figure`, never
 through ``pyplot``: nothing here switches matplotlib's global backend or keeps figures
 alive in pyplot's registry, so the package can plot inside a user's notebook session.
+
+Every file is written by :func:`vc_gym.persistence.write_atomic`: its content goes to a
+temporary file ``.{name}.{8 random characters}.tmp{suffix}`` in the same folder, which
+is flushed to the disk (``fsync``) and then renamed over the result, and the folder is
+synced too, so that a power cut leaves the old file or the new one, never an empty one.
+:func:`check_out_file` and :func:`check_out_dir` make sure, before any work starts, that
+those names fit the file system and the folder can be written, so that a result is never
+computed only to be lost.
 """
 
 from __future__ import annotations
@@ -10,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -19,72 +28,312 @@ from matplotlib.figure import Figure
 from vc_gym.persistence import write_atomic
 
 __all__ = [
+    "DEFAULT_NAME_MAX",
+    "DEFAULT_PATH_MAX",
+    "MAX_JSON_BYTES",
+    "OUT_DIR_NAME_RESERVE",
+    "TEMP_NAME_EXTRA",
     "check_out_dir",
     "check_out_file",
     "new_figure",
     "new_out_dir",
+    "read_json",
     "save_figure",
     "write_json",
 ]
 
+#: Longest file name (bytes) assumed where the file system does not say
+#: (``os.pathconf(folder, "PC_NAME_MAX")``).
+DEFAULT_NAME_MAX = 255
+#: Longest path (bytes) assumed where the file system does not say (``PC_PATH_MAX``).
+DEFAULT_PATH_MAX = 4096
+#: Bytes the atomic writer's temporary name adds to a file's name and suffix:
+#: ``"."`` + name + ``"."`` + 8 random characters + ``".tmp"`` + suffix.
+TEMP_NAME_EXTRA = 1 + 1 + 8 + len(".tmp")
+#: Bytes of path kept free below an output folder for what a run writes inside it
+#: (``jobs/<stage>/<key>.json`` and their temporary names).
+OUT_DIR_NAME_RESERVE = 255
+#: Largest JSON file :func:`read_json` reads (bytes): far above any result or job
+#: file vc_gym writes.
+MAX_JSON_BYTES = 64 * 2**20
 
-def check_out_dir(path: str | os.PathLike) -> Path:
+
+def _limit(folder: Path, name: str, default: int) -> int:
+    """``os.pathconf(folder, name)``, or ``default`` where the system does not say."""
+    try:
+        value = os.pathconf(folder, name)
+    except (OSError, ValueError, AttributeError):
+        return default
+    return value if value and value > 0 else default
+
+
+def _exists(path: Path) -> bool:
+    """``path.exists()``, False where the path cannot even be looked up (a name too long)."""
+    try:
+        return path.exists()
+    except OSError:
+        return False
+
+
+def _is_dir(path: Path) -> bool:
+    """``path.is_dir()``, False where the path cannot even be looked up."""
+    try:
+        return path.is_dir()
+    except OSError:
+        return False
+
+
+def _shown(path: Path) -> str:
+    """``path`` for an error message, shortened in the middle when long."""
+    text = str(path)
+    return text if len(text) <= 100 else f"{text[:60]}...{text[-30:]}"
+
+
+def _existing_ancestor(path: Path) -> Path:
+    """The nearest folder at or above ``path`` that exists (what ``pathconf`` can ask)."""
+    p = path.absolute()
+    while not _exists(p) and p != p.parent:
+        p = p.parent
+    return p
+
+
+def _check_name_fits(label: str, name: str, folder: Path, extra: int = 0) -> None:
+    """Refuse ``name`` if it, plus ``extra`` bytes of temporary name, does not fit
+    ``folder``'s name limit (``PC_NAME_MAX``)."""
+    name_max = _limit(_existing_ancestor(folder), "PC_NAME_MAX", DEFAULT_NAME_MAX)
+    size = len(os.fsencode(name))
+    if size + extra <= name_max:
+        return
+    shown = name if len(name) <= 40 else name[:40] + "..."
+    if extra:
+        raise ValueError(
+            f"{label}: the name {shown!r} is {size} bytes; with the {extra} bytes its "
+            f"temporary file adds it must fit the file system's {name_max}-byte limit: "
+            f"give a name of at most {name_max - extra} bytes"
+        )
+    raise ValueError(
+        f"{label}: the folder name {shown!r} is {size} bytes, more than the file "
+        f"system's {name_max}-byte limit"
+    )
+
+
+def _check_path_fits(label: str, folder: Path, reserve: int) -> None:
+    """Refuse ``folder`` if its absolute path plus ``reserve`` bytes exceeds the path
+    limit (``PC_PATH_MAX``; ``label`` starts the error message)."""
+    path_max = _limit(_existing_ancestor(folder), "PC_PATH_MAX", DEFAULT_PATH_MAX)
+    size = len(os.fsencode(str(folder.absolute())))
+    if size + reserve > path_max:
+        raise ValueError(
+            f"{label}: the path is {size} bytes; with {reserve} bytes for what is "
+            f"written there it must fit the file system's {path_max}-byte limit"
+        )
+
+
+def _prepare_dir(label: str, folder: Path, reserve: int) -> None:
+    """Check every name of ``folder`` and its length with ``reserve`` bytes to spare,
+    create it and write and remove a file in it (``label`` starts the error messages)."""
+    for part in folder.parts:
+        if part not in (folder.anchor, ".", ".."):
+            _check_name_fits(label, part, folder)
+    _check_path_fits(label, folder, reserve)
+    if _exists(folder) and not _is_dir(folder):
+        raise ValueError(f"{label}: {_shown(folder)} exists and is not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ValueError(f"{label}: cannot write there ({exc.strerror or exc})") from None
+
+
+def check_out_dir(path: str | os.PathLike, flag: str = "--out") -> Path:
     """Make sure ``path`` is (or can become) a writable folder, before any work starts.
+
+    The folder is created (with its parents) and a file is written and removed in it;
+    folders it created are removed again when it refuses the path.
+    Every part of the path must fit the file system's name limit (``PC_NAME_MAX``), and
+    the whole path must leave :data:`OUT_DIR_NAME_RESERVE` bytes below the path limit
+    (``PC_PATH_MAX``) for the files a run writes inside it.
+
+    Parameters
+    ----------
+    path : path-like
+        The folder.
+    flag : str
+        The option that named it, starting the error messages.
 
     Raises
     ------
     ValueError
-        ``--out PATH: ...`` for an existing file or a place that cannot be written.
+        ``--out PATH: ...`` for an existing file, a name or path too long for the file
+        system, or a place that cannot be written.
     """
+    if os.fspath(path) == "":
+        raise ValueError(f"{flag}: give a folder name")
     out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out}: exists and is not a folder")
+    made = _created_dirs(out)
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / f".write-test-{os.getpid()}"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise ValueError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
+        _prepare_dir(f"{flag} {_shown(out)}", out, OUT_DIR_NAME_RESERVE)
+    except ValueError:
+        _remove_empty(made)  # a refused folder leaves nothing behind
+        raise
     return out
+
+
+def _created_dirs(path: Path) -> list[Path]:
+    """The folders that creating ``path`` (with its parents) would make, deepest first."""
+    made = []
+    p = path.absolute()
+    while not _exists(p) and p != p.parent:
+        made.append(p)
+        p = p.parent
+    return made
 
 
 @contextlib.contextmanager
 def new_out_dir(path: str | os.PathLike) -> Iterator[Path]:
-    """:func:`check_out_dir` for a run: if the run fails before it writes anything, a
-    folder this call created is removed again (a refused argument leaves nothing)."""
-    existed = Path(path).exists()
+    """:func:`check_out_dir` for a run: if the run fails (or is interrupted) before it
+    writes anything, the folders this call created are removed again (a refused
+    argument leaves nothing)."""
+    made = _created_dirs(Path(path))
     out = check_out_dir(path)
     try:
         yield out
     except BaseException:
-        if not existed and out.is_dir() and not any(out.iterdir()):
-            out.rmdir()
+        _remove_empty(made)
         raise
 
 
-def check_out_file(path: str | os.PathLike) -> Path:
+def check_out_file(path: str | os.PathLike, flag: str = "--out") -> Path:
     """Make sure a result file can be written at ``path``, before any work starts (its
     folder is created; an existing file there will be replaced).
+
+    The file's name and the atomic writer's temporary name for it
+    (``.{name}.{8 characters}.tmp{suffix}``) must both fit the file system's name limit
+    (``PC_NAME_MAX``, :data:`DEFAULT_NAME_MAX` where unknown), and such a temporary file
+    is created and removed in the folder as a test.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    flag : str
+        The option that named it, starting the error messages (e.g. ``"--plot"``).
 
     Raises
     ------
     ValueError
-        ``--out PATH: ...`` for a folder or a place that cannot be written.
+        ``--out PATH: ...`` for a folder, a name too long for the file system, or a
+        place that cannot be written.
     """
+    if os.fspath(path) == "":
+        raise ValueError(f"{flag}: give a file name (e.g. result.json)")
     out = Path(path)
-    if out.is_dir():
-        raise ValueError(f"--out {out}: is a folder; give a file name (e.g. {out / 'bench.json'})")
-    check_out_dir(out.parent if str(out.parent) else ".")
+    label = f"{flag} {_shown(out)}"
+    folder = out.parent if str(out.parent) else Path(".")
+    extra = TEMP_NAME_EXTRA + len(os.fsencode(out.suffix))
+    _check_name_fits(label, out.name, folder, extra)
+    if _is_dir(out):
+        raise ValueError(f"{label}: is a folder; give a file name (e.g. {out / 'bench.json'})")
+    made = _created_dirs(folder)
+    try:
+        _prepare_dir(label, folder, len(os.fsencode(out.name)) + extra + 1)
+        try:
+            # exactly the temporary name write_atomic will use (same prefix and suffix)
+            fd, probe = tempfile.mkstemp(
+                prefix=f".{out.name}.", suffix=".tmp" + out.suffix, dir=folder
+            )
+            os.close(fd)
+            os.unlink(probe)
+        except OSError as exc:
+            raise ValueError(f"{label}: cannot write there ({exc.strerror or exc})") from None
+    except ValueError:
+        _remove_empty(made)
+        raise
     return out
 
 
+def _remove_empty(made: list[Path]) -> None:
+    """Remove the folders in ``made`` (deepest first) while they are empty."""
+    for folder in made:
+        try:
+            folder.rmdir()
+        except OSError:
+            break
+
+
+def _fsync_dir(folder: Path) -> None:
+    """Sync ``folder`` (a rename in it is durable only then); skipped where folders
+    cannot be opened (Windows)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _write_synced(tmp: str, data: bytes) -> None:
+    """Write ``data`` to ``tmp`` and flush it to the disk before it is renamed."""
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+
+
+def _sync_file(tmp: str) -> None:
+    """Flush a file another writer has closed to the disk."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 def write_json(path: str | os.PathLike, obj: object) -> None:
-    """Write ``obj`` as indented JSON to ``path`` atomically (its folder is created)."""
+    """Write ``obj`` as indented JSON to ``path`` atomically and durably (its folder is
+    created; the temporary file is synced before the rename, the folder after it)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    text = json.dumps(obj, indent=2)
-    write_atomic(path, lambda tmp: Path(tmp).write_text(text))
+    data = json.dumps(obj, indent=2).encode("utf-8")
+    write_atomic(path, lambda tmp: _write_synced(tmp, data))
+    _fsync_dir(path.parent if str(path.parent) else Path("."))
+
+
+def read_json(path: str | os.PathLike, max_bytes: int = MAX_JSON_BYTES) -> Any:
+    """Read a JSON file of at most ``max_bytes`` bytes.
+
+    Only a regular file is opened (a FIFO or a device named like a result would block
+    or never end), and no more than ``max_bytes + 1`` bytes are read, so a file that
+    grows while it is read cannot exhaust memory.
+
+    Raises
+    ------
+    ValueError
+        Naming the file: not a regular file, unreadable, larger than ``max_bytes``,
+        not UTF-8, not valid JSON or nested too deeply.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"{p}: not a regular file")
+    try:
+        with open(p, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise ValueError(f"{p}: cannot read it ({exc.strerror or exc})") from None
+    if len(data) > max_bytes:
+        raise ValueError(f"{p}: larger than {max_bytes} bytes")
+    try:
+        return json.loads(data.decode("utf-8"))
+    except RecursionError:
+        raise ValueError(f"{p}: nested too deeply") from None
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"{p}: not valid JSON ({exc})") from None
 
 
 def new_figure(**kwargs: Any) -> Figure:
@@ -93,7 +342,13 @@ def new_figure(**kwargs: Any) -> Figure:
 
 
 def save_figure(fig: Figure, path: str | os.PathLike, dpi: int = 100) -> None:
-    """Save a figure as PNG to ``path`` atomically (its folder is created)."""
+    """Save a figure as PNG to ``path`` atomically and durably (its folder is created)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
+
+    def write(tmp: str) -> None:
+        fig.savefig(tmp, dpi=dpi, format="png")
+        _sync_file(tmp)
+
+    write_atomic(path, write)
+    _fsync_dir(path.parent if str(path.parent) else Path("."))

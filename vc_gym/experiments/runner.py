@@ -9,15 +9,20 @@ the jobs.
 
 :class:`ExperimentRun` owns an experiment's output folder: every finished job is written
 to ``DIR/jobs/<stage>/<key>.json`` at once, so an interrupted run resumes where it stopped
-(no finished job is redone, none is lost). A job that raises, or whose worker dies, is
-retried once and then reported in ``results.json`` (``failed_jobs``), never dropped.
+(no finished job is redone, none is lost). A saved job file that cannot be trusted (torn,
+foreign, larger than :data:`MAX_JOB_FILE_BYTES`, not a regular file) counts as not saved:
+its job runs again. A job that raises, or whose worker dies, is retried once and then
+reported in ``results.json`` (``failed_jobs``), never dropped.
 :meth:`ExperimentRun.finish` writes ``results.json`` (figures only: the same seed gives the
-same bytes) and ``run.json`` (timings, jobs per second, backend, package versions).
+same bytes) and ``run.json`` (timings, jobs per second, backend, package versions, and
+every stage of the run with the keys of the jobs loaded from saved files, including a
+stage whose jobs were all saved before and which the experiment therefore skipped).
 
 Backends: :class:`LocalBackend` (a process pool; one worker runs the jobs in this
 process) and :class:`RayBackend` (Ray: a local instance, or an existing cluster by
 address). Both keep their workers' numeric libraries single-threaded: the workers are
-the parallelism (DESIGN.md).
+the parallelism (DESIGN.md). Both take at most :func:`max_workers` workers
+(:data:`MAX_WORKERS_PER_CPU` per CPU, at most :data:`MAX_WORKERS`).
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ import math
 import multiprocessing as mp
 import os
 import platform
+import signal
 import threading
 import time
 import traceback
@@ -40,10 +46,14 @@ from typing import Any
 
 from tqdm import tqdm
 
-from vc_gym.experiments.output import check_out_dir, write_json
+from vc_gym.config_files import read_settings
+from vc_gym.experiments.output import check_out_dir, read_json, write_json
 
 __all__ = [
     "BACKENDS",
+    "MAX_JOB_FILE_BYTES",
+    "MAX_WORKERS",
+    "MAX_WORKERS_PER_CPU",
     "Job",
     "JobOutcome",
     "ExperimentRun",
@@ -51,7 +61,9 @@ __all__ = [
     "RayBackend",
     "call_job",
     "check_out_dir",
+    "check_workers",
     "make_backend",
+    "max_workers",
     "worker_cache",
 ]
 
@@ -59,6 +71,14 @@ __all__ = [
 #: ``results.json``.
 TIMING = "timing"
 BACKENDS = ("local", "ray")
+#: Most workers per CPU of this machine a local pool or a local Ray instance may have:
+#: more only queue for the same cores, each holding its own simulator (~1 GB).
+MAX_WORKERS_PER_CPU = 4
+#: Most workers of a backend on any machine.
+MAX_WORKERS = 256
+#: Largest saved job file read when a run resumes (bytes); a larger one is not
+#: trusted and its job runs again. Job outputs are figures, kilobytes each.
+MAX_JOB_FILE_BYTES = 64 * 2**20
 #: Environment of every worker: one thread per numeric library.
 SINGLE_THREADED = {
     "OMP_NUM_THREADS": "1",
@@ -169,9 +189,35 @@ def worker_cache(key: Any, make: Callable[[], Any], limit: int = 4) -> Any:
     return value
 
 
+def max_workers() -> int:
+    """Most workers a backend may have on this machine: :data:`MAX_WORKERS_PER_CPU` per
+    CPU, at most :data:`MAX_WORKERS`."""
+    return min(MAX_WORKERS, MAX_WORKERS_PER_CPU * (os.cpu_count() or 1))
+
+
+def check_workers(workers: object, name: str = "workers", minimum: int = 1) -> int:
+    """``workers`` as an int in ``minimum..max_workers()``, else a ``ValueError`` naming
+    ``name`` (e.g. ``"--workers"``) and the range."""
+    limit = max_workers()
+    if (
+        isinstance(workers, bool)
+        or not isinstance(workers, int)
+        or not (minimum <= workers <= limit)
+    ):
+        raise ValueError(
+            f"{name} must be an int in {minimum}..{limit} ({MAX_WORKERS_PER_CPU} per CPU; "
+            f"this machine has {os.cpu_count() or 1}; never more than {MAX_WORKERS}), "
+            f"got {workers!r}"
+        )
+    return workers
+
+
 def _init_worker(quiet: bool = False, parent_pid: int | None = None) -> None:
     os.environ.update(SINGLE_THREADED)
     if parent_pid is not None:
+        # a pool worker: Ctrl-C in a terminal reaches the whole process group, and the
+        # parent, not each worker, handles it (it stops the workers)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         threading.Thread(
             target=_exit_with_parent, args=(parent_pid,), name="parent-watch", daemon=True
         ).start()
@@ -187,6 +233,11 @@ def _init_worker(quiet: bool = False, parent_pid: int | None = None) -> None:
         cv2.setNumThreads(1)
     except ImportError:  # pragma: no cover - OpenCV is a dependency
         pass
+    if parent_pid is not None:
+        # a job's progress bar would create tqdm's default lock, a multiprocessing
+        # semaphore; a worker stopped by Ctrl-C cannot release it and the resource
+        # tracker then warns of a leak. One worker's bars need only a thread lock.
+        tqdm.set_lock(threading.RLock())
 
 
 def _exit_with_parent(parent_pid: int, period_s: float = 1.0) -> None:
@@ -213,9 +264,7 @@ class LocalBackend:
     name = "local"
 
     def __init__(self, workers: int = 2):
-        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-            raise ValueError(f"workers must be an int >= 1, got {workers!r}")
-        self.workers = workers
+        self.workers = check_workers(workers)
         self._executor: cf.ProcessPoolExecutor | None = None
 
     def describe(self) -> dict[str, Any]:
@@ -224,8 +273,10 @@ class LocalBackend:
     def __enter__(self) -> LocalBackend:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        # interrupted (Ctrl-C, SystemExit): stop the running jobs instead of waiting
+        # for them; their results are lost, every finished job is saved already
+        self.close(stop=exc_type is not None and not issubclass(exc_type, Exception))
 
     def run(self, jobs: Sequence[Job]) -> Iterator[tuple[int, bool, Any, float]]:
         """Yield ``(index, ok, output or error, seconds)`` as jobs finish."""
@@ -256,11 +307,28 @@ class LocalBackend:
                         os.environ[k] = v
         return self._executor
 
-    def close(self) -> None:
-        """Stop the worker processes (a later :meth:`run` starts new ones)."""
-        if self._executor is not None:
-            self._executor.shutdown(wait=True, cancel_futures=True)
-            self._executor = None
+    def close(self, stop: bool = False) -> None:
+        """Stop the worker processes (a later :meth:`run` starts new ones).
+
+        Parameters
+        ----------
+        stop : bool
+            Terminate the workers at once, abandoning the jobs they are running,
+            instead of waiting for those jobs to finish.
+        """
+        if self._executor is None:
+            return
+        executor, self._executor = self._executor, None
+        if not stop:
+            executor.shutdown(wait=True, cancel_futures=True)
+            return
+        processes = list((getattr(executor, "_processes", None) or {}).values())
+        for proc in processes:
+            proc.terminate()
+        for proc in processes:
+            proc.join(timeout=5.0)
+        # the workers are gone: the pool notices at once and frees its queues
+        executor.shutdown(wait=True, cancel_futures=True)
 
     def _discard_pool(self) -> None:
         """Drop a broken pool; the next :meth:`_pool` starts fresh workers."""
@@ -367,8 +435,8 @@ class RayBackend:
             import ray  # noqa: F401
         except ImportError:
             raise ValueError("the ray backend needs Ray: pip install 'vc_gym[cluster]'") from None
-        if workers is not None and (isinstance(workers, bool) or workers < 1):
-            raise ValueError(f"workers must be an int >= 1, got {workers!r}")
+        if workers is not None:
+            check_workers(workers)
         self.address = address
         self.workers = workers
         self._started = False
@@ -445,7 +513,17 @@ def _ray_execute(fn: str, kwargs: dict[str, Any]) -> tuple[bool, Any, float]:
 def make_backend(
     name: str = "local", workers: int | None = None, address: str | None = None
 ) -> LocalBackend | RayBackend:
-    """A backend by name: ``"local"`` (default 2 workers) or ``"ray"``."""
+    """A backend by name: ``"local"`` (default 2 workers) or ``"ray"``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, an address with the local backend, or ``workers`` outside
+        ``1..max_workers()`` (:data:`MAX_WORKERS_PER_CPU` per CPU, at most
+        :data:`MAX_WORKERS`); checked before any worker starts.
+    """
+    if workers is not None:
+        check_workers(workers)
     if name == "local":
         if address:
             raise ValueError("--address is for the ray backend")
@@ -528,11 +606,14 @@ class ExperimentRun:
     def _check_settings(self) -> None:
         marker = self.out / "jobs" / "settings.json"
         mine = {"experiment": self.experiment, **self.settings}
-        if marker.is_file():
-            try:
-                theirs = json.loads(marker.read_text())
-            except (OSError, ValueError):
-                theirs = None
+        if marker.exists() or marker.is_symlink():
+            try:  # bounded in size and depth (MAX_SETTINGS_BYTES)
+                theirs = read_settings(marker)
+            except ValueError as exc:
+                raise ValueError(
+                    f"{self.out} holds jobs whose settings cannot be read ({exc}); choose "
+                    "another --out"
+                ) from None
             if theirs != mine:
                 raise ValueError(
                     f"{self.out} holds the jobs of another run ({theirs}); resume it with the "
@@ -545,15 +626,10 @@ class ExperimentRun:
         return self.out / "jobs" / stage / f"{key}.json"
 
     def _saved(self, stage: str, job: Job) -> JobOutcome | None:
-        path = self.job_file(stage, job.key)
-        if not path.is_file():
-            return None
-        try:
-            rec = json.loads(path.read_text())
-        except (OSError, ValueError):
-            return None  # a torn or foreign file: run the job again
-        if not isinstance(rec, dict) or not rec.get("ok"):
+        rec = self._read_job_file(self.job_file(stage, job.key))
+        if rec is None or not rec.get("ok"):
             return None  # failed last time: try again
+        path = self.job_file(stage, job.key)
         if rec.get("fn") != job.fn or rec.get("kwargs") != json.loads(json.dumps(job.kwargs)):
             raise ValueError(f"{path} was written by a job with other arguments; use another --out")
         return JobOutcome(
@@ -565,6 +641,21 @@ class ExperimentRun:
             rec.get("seconds"),
             resumed=True,
         )
+
+    @staticmethod
+    def _read_job_file(path: Path) -> dict[str, Any] | None:
+        """A saved job's record, or None where there is none to trust: no regular file
+        (a FIFO or device is never opened), one larger than :data:`MAX_JOB_FILE_BYTES`,
+        a torn or foreign file, or a record without an output object."""
+        if not path.is_file():
+            return None
+        try:
+            rec = read_json(path, MAX_JOB_FILE_BYTES)
+        except ValueError:
+            return None  # its job runs again and replaces it
+        if not isinstance(rec, dict) or (rec.get("ok") and not isinstance(rec.get("output"), dict)):
+            return None
+        return rec
 
     def run(self, stage: str, jobs: Sequence[Job]) -> list[dict[str, Any] | None]:
         """Run the jobs of one stage; return their outputs in job order.
@@ -623,6 +714,7 @@ class ExperimentRun:
             retried=retried,
             wall=wall,
             seconds=[o.seconds for o in ran if o.seconds is not None and math.isfinite(o.seconds)],
+            resumed_keys=[j.key for j in jobs if outcomes[j.key].resumed],
         )
         results: list[dict[str, Any] | None] = []
         stage_timing: dict[str, Any] = {}
@@ -650,6 +742,7 @@ class ExperimentRun:
             for k in ("jobs", "ran", "failed", "retried", "wall"):
                 new[k] += old[k]
             new["seconds"] = old["seconds"] + new["seconds"]
+            new["resumed_keys"] = old["resumed_keys"] + new["resumed_keys"]
         self._stage_raw[stage] = new
         secs = sorted(new["seconds"])
         ran, wall = new["ran"], new["wall"]
@@ -662,7 +755,62 @@ class ExperimentRun:
             "wall_s": round(wall, 3),
             "jobs_per_s": round(ran / wall, 4) if ran and wall > 0 else None,
             "job_s_median": round(secs[len(secs) // 2], 4) if secs else None,
+            "resumed_keys": list(new["resumed_keys"]),
         }
+
+    def _record_saved_stages(self) -> None:
+        """Record the stages this call never ran whose jobs are saved in the folder.
+
+        An experiment skips a stage whose products are all on disk already (a resumed
+        run finds its atlases saved and does not call :meth:`run` for ``learn``); the
+        stage still belongs to the run, so it is recorded with every saved job as
+        resumed (and their timings), before the stages run in this call.
+        """
+        root = self.out / "jobs"
+        found: list[tuple[float, str, list[str], dict[str, Any]]] = []
+        try:
+            folders = sorted(p for p in root.iterdir() if p.is_dir())
+        except OSError:
+            return
+        for folder in folders:
+            stage = folder.name
+            if stage in self.stages or stage.startswith("."):
+                continue
+            keys, timings, first = [], {}, math.inf
+            for path in sorted(folder.glob("*.json")):
+                if path.name.startswith("."):  # a temporary file of an interrupted write
+                    continue
+                rec = self._read_job_file(path)
+                if rec is None or not rec.get("ok"):
+                    continue
+                keys.append(path.stem)
+                timing = rec["output"].get(TIMING)
+                if timing is not None:
+                    timings[path.stem] = timing
+                try:
+                    first = min(first, path.stat().st_mtime)
+                except OSError:
+                    pass
+            if keys:
+                found.append((first, stage, keys, timings))
+        if not found:
+            return
+        ran_now = dict(self.stages)
+        self.stages.clear()
+        for _, stage, keys, timings in sorted(found):
+            self._record_stage(
+                stage,
+                jobs=len(keys),
+                ran=0,
+                failed=0,
+                retried=0,
+                wall=0.0,
+                seconds=[],
+                resumed_keys=keys,
+            )
+            if timings:
+                self.timings.setdefault(stage, {}).update(timings)
+        self.stages.update(ran_now)
 
     def _save(self, stage: str, job: Job, outcome: JobOutcome, out: Any) -> None:
         rec = {
@@ -694,6 +842,7 @@ class ExperimentRun:
         }
         doc = json.loads(json.dumps(doc, allow_nan=True))
         write_json(self.out / "results.json", doc)
+        self._record_saved_stages()
         run = {
             "experiment": self.experiment,
             **self.backend.describe(),

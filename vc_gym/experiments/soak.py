@@ -32,13 +32,63 @@ import numpy as np
 from tqdm import tqdm
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.validation import int_at_least
+from vc_gym.validation import check_seed, int_in_range
 
-__all__ = ["GROWTH_TARGET_KB", "heap_in_use_bytes", "release_free_memory", "rss_bytes", "soak"]
+__all__ = [
+    "GROWTH_TARGET_KB",
+    "MAX_SOAK_CYCLES",
+    "MAX_SOAK_STEPS",
+    "MIN_SOAK_CYCLES",
+    "MIN_WINDOW",
+    "check_soak_args",
+    "heap_in_use_bytes",
+    "release_free_memory",
+    "rss_bytes",
+    "soak",
+]
 
 ENV_ID = "vc_gym/AiboRoom-v0"
 #: Growth per make/close cycle that counts as "within noise" (KB).
 GROWTH_TARGET_KB = 5.0
+#: Fewest steps per measurement window (a rate over fewer is noise).
+MIN_WINDOW = 10
+#: Most steps of the long run: 20 times the full soak's 50,000 (a few hours).
+MAX_SOAK_STEPS = 1_000_000
+#: Fewest make/close cycles (a slope needs a few after the warm-up quarter).
+MIN_SOAK_CYCLES = 10
+#: Most make/close cycles: 50 times the full soak's 200 (about an hour).
+MAX_SOAK_CYCLES = 10_000
+
+
+def check_soak_args(
+    steps: object,
+    cycles: object,
+    window: object,
+    seed: object = 0,
+    names: tuple[str, str, str, str] = ("steps", "cycles", "window", "seed"),
+) -> None:
+    """Check :func:`soak`'s counts before any work (a command checks them first too).
+
+    Parameters
+    ----------
+    steps, cycles, window, seed : int
+        As :func:`soak`: ``window`` in ``MIN_WINDOW..MAX_SOAK_STEPS // 2``, ``steps`` in
+        ``2 * window..MAX_SOAK_STEPS``, ``cycles`` in
+        ``MIN_SOAK_CYCLES..MAX_SOAK_CYCLES``, ``seed`` in ``0..MAX_SEED``.
+    names : tuple of str
+        The names of the four in error messages (a command's flags, e.g.
+        ``("--soak-steps", "--soak-cycles", "window", "seed")``).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and its accepted range.
+    """
+    n_steps, n_cycles, n_window, n_seed = names
+    w = int_in_range(n_window, window, MIN_WINDOW, MAX_SOAK_STEPS // 2)
+    int_in_range(n_steps, steps, 2 * w, MAX_SOAK_STEPS)
+    int_in_range(n_cycles, cycles, MIN_SOAK_CYCLES, MAX_SOAK_CYCLES)
+    check_seed(n_seed, seed)
 
 
 def rss_bytes() -> int:
@@ -128,11 +178,12 @@ def soak(
     Parameters
     ----------
     steps : int
-        Steps of the long run (>= 2 windows).
+        Steps of the long run (2 windows to :data:`MAX_SOAK_STEPS`).
     cycles : int
-        Make / reset / step / close cycles (>= 10).
+        Make / reset / step / close cycles (:data:`MIN_SOAK_CYCLES` to
+        :data:`MAX_SOAK_CYCLES`).
     window : int
-        Steps per measurement window of the long run.
+        Steps per measurement window of the long run (at least :data:`MIN_WINDOW`).
     seed : int
         Seed of the resets and the random actions.
     progress : bool
@@ -150,9 +201,7 @@ def soak(
         ``heap_growth_kb_per_cycle``; None without glibc) and whether free memory was
         given back before each sample (``free_memory_released``).
     """
-    int_at_least("window", window, 10)
-    int_at_least("steps", steps, 2 * window)
-    int_at_least("cycles", cycles, 10)
+    check_soak_args(steps, cycles, window, seed)
     kwargs = dict(env_kwargs or {})
     rng = np.random.default_rng(seed)
     env = gym.make(ENV_ID, **kwargs)
