@@ -7,6 +7,7 @@ import json
 import pytest
 
 from vc_gym.config_files import MAX_SETTINGS_BYTES, MAX_SETTINGS_DEPTH, read_settings
+from vc_gym.experiments.check_security import alias_bomb
 
 
 @pytest.mark.parametrize("name", ["s.json", "s.yml", "s.yaml"])
@@ -56,17 +57,9 @@ def test_huge_missing_and_binary_files_are_refused(tmp_path):
     assert MAX_SETTINGS_DEPTH >= 5
 
 
-def _alias_bomb(levels: int = 9) -> str:
-    lines = ['a0: &a0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
-    for i in range(1, levels):
-        refs = ", ".join([f"*a{i - 1}"] * 10)
-        lines.append(f"a{i}: &a{i} [{refs}]")
-    return "\n".join(lines) + "\n"
-
-
 def test_a_yaml_alias_bomb_is_refused_at_once(tmp_path):
     path = tmp_path / "bomb.yml"
-    path.write_text(_alias_bomb())
+    path.write_text(alias_bomb())
     assert path.stat().st_size < 1000
     with pytest.raises(ValueError, match="aliases") as err:
         read_settings(path)

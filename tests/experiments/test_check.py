@@ -14,7 +14,17 @@ def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
     r = json.loads(out.read_text())
     assert code == 0, r["failures"]
     assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 110
-    assert set(r["suites"]) == {"bad_input", "hostile_file", "sensors", "envs", "fault"}
+    assert set(r["suites"]) == {
+        "bad_input",
+        "hostile_file",
+        "sensors",
+        "envs",
+        "fault",
+        "code_in_files",
+        "exhaustion",
+        "runs",
+        "arguments",
+    }
     assert r["soak"]["steps"] == 40 and r["soak"]["median_steps_per_s"] > 0
     assert "failed 0" in capsys.readouterr().out
 

@@ -17,7 +17,6 @@ from __future__ import annotations
 import base64
 import functools
 import io
-import json
 import os
 import pickle
 import tempfile
@@ -25,7 +24,6 @@ import time
 import traceback
 import zipfile
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -34,12 +32,13 @@ import numpy as np
 from tqdm import tqdm
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.agents.learned import PRETRAINED_MODEL
 from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
 from vc_gym.baselines import load_sensor, make_sensor
 from vc_gym.compass import Camera, CompassConfig, VisualCompass
 from vc_gym.config_files import read_settings
 from vc_gym.errors import MapFileError, NotLearnedError
+from vc_gym.experiments.check_case import Case, raises
+from vc_gym.experiments.check_security import model_with_data, security_cases
 from vc_gym.experiments.runner import ExperimentRun, Job, LocalBackend
 from vc_gym.experiments.soak import soak
 from vc_gym.experiments.training import TrainConfig
@@ -52,31 +51,6 @@ __all__ = ["Case", "all_cases", "run_check"]
 
 #: A case taking longer than this (seconds) fails as a hang.
 CASE_TIME_LIMIT_S = 60.0
-
-
-@dataclass(frozen=True)
-class Case:
-    """One check: ``run(tmp)`` raises ``AssertionError`` (or anything) when it fails."""
-
-    suite: str
-    name: str
-    run: Callable[[Path], None]
-
-
-def _raises(
-    kind: type[BaseException] | tuple[type[BaseException], ...],
-    match: str,
-    fn: Callable[[], object],
-) -> None:
-    """``fn()`` must raise ``kind`` (or one of them) whose message contains ``match``."""
-    try:
-        fn()
-    except kind as exc:
-        if match.lower() not in str(exc).lower():
-            raise AssertionError(f"{type(exc).__name__} without {match!r}: {exc}") from None
-        return
-    names = [k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,))]
-    raise AssertionError(f"no {' or '.join(names)} raised")
 
 
 # --------------------------------------------------------------------------- bad input
@@ -114,8 +88,8 @@ def _flat_frame(kind: str) -> Callable[[Path], None]:
 def _kalman_survives(_: Path) -> None:
 
     f = KalmanHeadingFilter(10.0, 5.0)
-    _raises(ValueError, "spread_deg", lambda: f.update(20.0, 1e-160))
-    _raises(ValueError, "within", lambda: f.predict(10.0, 1e155))
+    raises(ValueError, "spread_deg", lambda: f.update(20.0, 1e-160))
+    raises(ValueError, "within", lambda: f.predict(10.0, 1e155))
     f.predict(1.0)
     f.update(12.0, 2.0)
     assert np.isfinite(f.estimate().heading_deg)
@@ -134,20 +108,20 @@ def _room_case(fn: Callable[[gym.Env], None], **kwargs: Any) -> Callable[[Path],
 
 def _nan_action(env: gym.Env) -> None:
     env.reset(seed=0)
-    _raises(ValueError, "finite", lambda: env.step(np.full(5, np.nan, np.float32)))
+    raises(ValueError, "finite", lambda: env.step(np.full(5, np.nan, np.float32)))
 
 
 def _closed_env(_: Path) -> None:
     env = gym.make("vc_gym/AiboRoom-v0")
     env.reset(seed=0)
     env.close()
-    _raises(RuntimeError, "closed", lambda: env.unwrapped.step(np.zeros(5, np.float32)))
+    raises(RuntimeError, "closed", lambda: env.unwrapped.step(np.zeros(5, np.float32)))
 
 
 def _margin(_: Path) -> None:
     env = gym.make("vc_gym/LearnThenHome-v0", kidnap_margin_m=100.0, learn_time_s=0.2)
     try:
-        _raises(ValueError, "kidnap_margin_m", lambda: env.reset(seed=0))
+        raises(ValueError, "kidnap_margin_m", lambda: env.reset(seed=0))
     finally:
         env.close()
 
@@ -188,7 +162,7 @@ def _bad_input_cases() -> list[Case]:
         "tracker 'nope'": lambda: make_tracker("nope"),
     }
     cases = [
-        Case("bad_input", name, lambda _, fn=fn: _raises(ValueError, "", fn))
+        Case("bad_input", name, lambda _, fn=fn: raises(ValueError, "", fn))
         for name, fn in simple.items()
     ]
     cases += [
@@ -199,7 +173,7 @@ def _bad_input_cases() -> list[Case]:
             "bad_input",
             "pose outside the walls",
             _room_case(
-                lambda e: _raises(
+                lambda e: raises(
                     ValueError, "walls", lambda: e.reset(seed=0, options={"pose": (100, 100, 0)})
                 )
             ),
@@ -213,7 +187,7 @@ def _bad_input_cases() -> list[Case]:
             "bad_input",
             "step before reset",
             _room_case(
-                lambda e: _raises(RuntimeError, "reset", lambda: e.unwrapped.step(np.zeros(5)))
+                lambda e: raises(RuntimeError, "reset", lambda: e.unwrapped.step(np.zeros(5)))
             ),
         ),
         Case("bad_input", "step after close", _closed_env),
@@ -244,7 +218,7 @@ def _write_zip(path: Path, entries: dict[str, bytes]) -> Path:
 
 
 def _refused(path: Path) -> None:
-    _raises(MapFileError, path.name, lambda: load_npz_checked(path, "vc_gym.Check", 1))
+    raises(MapFileError, path.name, lambda: load_npz_checked(path, "vc_gym.Check", 1))
 
 
 def _zip_bomb(tmp: Path) -> None:
@@ -315,7 +289,7 @@ def _map_light_tampered(tmp: Path) -> None:
     ):
         bad = {k: v for k, v in {**arrays, **change}.items() if v is not None}
         np.savez(tmp / "bad_light.npz", **bad)
-        _raises(MapFileError, why, lambda: VisualCompass.load(tmp / "bad_light.npz"))
+        raises(MapFileError, why, lambda: VisualCompass.load(tmp / "bad_light.npz"))
     _load_bit_flipped(good, 40, VisualCompass.load, tmp)
 
 
@@ -334,7 +308,7 @@ def _deep_map_config(tmp: Path) -> None:
     arrays = dict(_learned().to_arrays())
     arrays["config"] = np.array("[" * 50_000 + "]" * 50_000)
     path = save_npz_atomic(tmp / "deep.npz", "vc_gym.VisualCompass", 1, arrays)
-    _raises(MapFileError, "deep.npz", lambda: VisualCompass.load(path))
+    raises(MapFileError, "deep.npz", lambda: VisualCompass.load(path))
 
 
 class _Payload:
@@ -351,17 +325,13 @@ def _hostile_model(tmp: Path) -> None:
 
     marker = tmp / "code-ran"
     payload = base64.b64encode(pickle.dumps(_Payload(str(marker)))).decode()
-    path = tmp / "model.zip"
-    with zipfile.ZipFile(PRETRAINED_MODEL) as zin, zipfile.ZipFile(path, "w") as zout:
-        for info in zin.infolist():
-            content = zin.read(info.filename)
-            if info.filename == "data":
-                data = json.loads(content)
-                data["lr_schedule"][":serialized:"] = payload
-                data["extra_object"] = {":type:": "<class 'x'>", ":serialized:": payload}
-                content = json.dumps(data).encode()
-            zout.writestr(info.filename, content)
-    _raises(UnsafeModelError, "", lambda: load_sb3_model("ppo", path))
+
+    def plant(data: dict[str, Any]) -> None:
+        data["lr_schedule"][":serialized:"] = payload
+        data["extra_object"] = {":type:": "<class 'x'>", ":serialized:": payload}
+
+    path = model_with_data(tmp, plant)
+    raises(UnsafeModelError, "", lambda: load_sb3_model("ppo", path))
     assert not marker.exists(), "code from the model file ran"
 
 
@@ -370,7 +340,7 @@ def _settings_file(text: str, name: str) -> Callable[[Path], None]:
 
         path = tmp / name
         path.write_text(text)
-        _raises(ValueError, name, lambda: read_settings(path))
+        raises(ValueError, name, lambda: read_settings(path))
 
     return run
 
@@ -435,7 +405,7 @@ def _baseline_other_file(name: str) -> Callable[[Path], None]:
     def run(tmp: Path) -> None:
         other = "feature" if name != "feature" else "image_difference"
         path = _baseline_file(other, tmp)
-        _raises(MapFileError, path.name, lambda: load_sensor(name, path))
+        raises(MapFileError, path.name, lambda: load_sensor(name, path))
 
     return run
 
@@ -448,7 +418,7 @@ def _baseline_tampered(name: str) -> Callable[[Path], None]:
         key = next(k for k in arrays if arrays[k].dtype.kind == "f" and arrays[k].size > 1)
         arrays[key] = np.full_like(arrays[key], np.nan)
         bad = save_npz_atomic(tmp / "tampered.npz", type(_learned_baseline(name)).schema, 1, arrays)
-        _raises(MapFileError, "tampered.npz", lambda: load_sensor(name, bad))
+        raises(MapFileError, "tampered.npz", lambda: load_sensor(name, bad))
 
     return run
 
@@ -469,14 +439,14 @@ def _sensor_cases() -> list[Case]:
             ),
         }
         cases += [
-            Case("sensors", f"{name}: {what}", lambda _, fn=fn: _raises(ValueError, "", fn))
+            Case("sensors", f"{name}: {what}", lambda _, fn=fn: raises(ValueError, "", fn))
             for what, fn in simple.items()
         ]
         cases += [
             Case(
                 "sensors",
                 f"{name}: estimate before learning",
-                lambda _, n=name: _raises(
+                lambda _, n=name: raises(
                     NotLearnedError, "", lambda: make_sensor(n).estimate(image, Camera())
                 ),
             ),
@@ -493,7 +463,7 @@ def _sensor_cases() -> list[Case]:
         "sensor 'nope'": lambda: make_sensor("nope"),
     }
     cases += [
-        Case("sensors", what, lambda _, fn=fn: _raises(ValueError, "", fn))
+        Case("sensors", what, lambda _, fn=fn: raises(ValueError, "", fn))
         for what, fn in magnetic.items()
     ]
     return cases
@@ -557,7 +527,7 @@ def _lost_client(_: Path) -> None:
     try:
         first, _ = env.reset(seed=3)
         env.unwrapped.client.disconnect()
-        _raises(RuntimeError, "physics server", lambda: env.step(np.zeros(5, np.float32)))
+        raises(RuntimeError, "physics server", lambda: env.step(np.zeros(5, np.float32)))
         again, _ = env.reset(seed=3)
         assert np.array_equal(first["image"], again["image"]), "reset did not rebuild the world"
     finally:
@@ -621,9 +591,9 @@ def _same_seed_same_start(shared: _SharedEnv) -> None:
 def _after_close(shared: _SharedEnv) -> None:
     env = shared.close()
     n = env.action_space.shape[0]
-    _raises(RuntimeError, "closed", lambda: env.step(np.zeros(n, np.float32)))
-    _raises(RuntimeError, "closed", lambda: env.reset(seed=0))
-    _raises(RuntimeError, "closed", env.render)
+    raises(RuntimeError, "closed", lambda: env.step(np.zeros(n, np.float32)))
+    raises(RuntimeError, "closed", lambda: env.reset(seed=0))
+    raises(RuntimeError, "closed", env.render)
 
 
 def _bad_actions(n: int) -> dict[str, Any]:
@@ -642,13 +612,13 @@ def _bad_actions(n: int) -> dict[str, Any]:
 def _step_before_reset(shared: _SharedEnv) -> None:
     env = shared.get()
     action = np.zeros(env.action_space.shape, np.float32)
-    _raises(gym.error.ResetNeeded, "reset", lambda: env.step(action))
+    raises(gym.error.ResetNeeded, "reset", lambda: env.step(action))
 
 
 def _bad_action(shared: _SharedEnv, name: str) -> None:
     env = shared.reset()
     action = _bad_actions(int(env.action_space.shape[0]))[name]
-    _raises(ValueError, "", lambda: env.step(action))
+    raises(ValueError, "", lambda: env.step(action))
 
 
 def _env_cases() -> list[Case]:
@@ -673,7 +643,7 @@ def _env_cases() -> list[Case]:
             cases.append(
                 case(
                     name,
-                    lambda s=shared, kw=kwargs: _raises(
+                    lambda s=shared, kw=kwargs: raises(
                         (ValueError, gym.error.Error), "", lambda: s.get().reset(**kw)
                     ),
                 )
@@ -693,6 +663,7 @@ def all_cases() -> list[Case]:
         *_sensor_cases(),
         *_env_cases(),
         *_fault_cases(),
+        *security_cases(),
     ]
 
 
