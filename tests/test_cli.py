@@ -97,16 +97,16 @@ def test_tracker_json_must_be_an_object(capsys):
 #: What each command would start: replaced in the tests below by a function that fails
 #: the test, so that an argument checked too late shows up as that failure.
 WORK = [
-    "vc_gym.experiments.output.new_out_dir",
-    "vc_gym.experiments.output.check_out_dir",
-    "vc_gym.experiments.output.check_out_file",
+    "vc_gym.jobs.output.new_out_dir",
+    "vc_gym.jobs.output.check_out_dir",
+    "vc_gym.jobs.output.check_out_file",
     "vc_gym.experiments.check.run_check",
-    "vc_gym.experiments.soak.soak",
+    "vc_gym.experiments.benchmarks.soak.soak",
     "vc_gym.experiments.demo.run_demo",
     "vc_gym.experiments.render_scenes.render_scene_pictures",
-    "vc_gym.experiments.bench_compass.bench_compass",
-    "vc_gym.experiments.bench_env.bench_env",
-    "vc_gym.experiments.bench_backends.bench_backends",
+    "vc_gym.experiments.benchmarks.compass.bench_compass",
+    "vc_gym.experiments.benchmarks.env.bench_env",
+    "vc_gym.experiments.benchmarks.backends.bench_backends",
 ]
 
 
@@ -195,7 +195,7 @@ def test_a_result_file_name_too_long_for_its_temporary_file_fails_first(
 
 def test_a_plot_name_too_long_fails_first(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(
-        "vc_gym.experiments.bench_filters.bench_filters",
+        "vc_gym.experiments.benchmarks.filters.bench_filters",
         lambda *a, **k: pytest.fail("work started"),
     )
     assert main(["bench", "filters", "--plot", str(tmp_path / ("p" * 245 + ".png"))]) == 2

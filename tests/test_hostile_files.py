@@ -221,7 +221,7 @@ settings_text = st.text(
 @FUZZ
 @given(text=settings_text)
 def test_a_settings_file_of_any_text_reads_or_is_refused(tmp_path, suffix, text):
-    from vc_gym.experiments.training import read_train_config
+    from vc_gym.training.train import read_train_config
 
     path = tmp_path / f"t{suffix}"
     path.write_text(text)
@@ -238,7 +238,7 @@ def test_a_settings_file_of_any_text_reads_or_is_refused(tmp_path, suffix, text)
 @FUZZ
 @given(data=st.data())
 def test_a_training_settings_file_with_any_values_is_read_or_refused(tmp_path, data):
-    from vc_gym.experiments.training import TrainConfig, read_train_config
+    from vc_gym.training.train import TrainConfig, read_train_config
 
     names = sorted(TrainConfig.__dataclass_fields__)
     values = {

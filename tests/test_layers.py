@@ -1,8 +1,9 @@
 """Layers point one way: every import in the package, lazy ones included, is checked.
 
-The order (DESIGN.md): the base helpers, then ``compass``, ``filters``, ``localization``,
-``worlds``, ``envs``, ``baselines``, ``agents``, ``experiments``, ``hyperparams`` (the RL
-Zoo's settings), ``cli``. A module may
+The order (docs/design.md): the base helpers, then ``compass``, ``filters``,
+``localization``, ``heading_sensors`` (and its deprecated alias ``baselines``), ``worlds``,
+``sim`` (the PyBullet world), ``envs`` (the tasks), ``jobs`` (the job runner), ``training``,
+``agents``, ``experiments``, ``hyperparams`` (the RL Zoo's settings), ``cli``. A module may
 import only its own layer and the layers before it; ``compass`` and ``filters`` never
 import each other (``localization`` joins them).
 """
@@ -33,9 +34,13 @@ ORDER = [
     "compass",
     "filters",
     "localization",
-    "worlds",
-    "envs",
+    "heading_sensors",
     "baselines",
+    "worlds",
+    "sim",
+    "envs",
+    "jobs",
+    "training",
     "agents",
     "experiments",
     "hyperparams",
@@ -123,7 +128,8 @@ def test_the_checker_catches_wrong_imports(tmp_path):
     fine = filters / "ok.py"
     fine.write_text("from vc_gym.angles import wrap180\nfrom . import grid\n")
     assert violations(fine, tmp_path) == []
-    assert layer_of("vc_gym.angles") == "base" and layer_of("vc_gym.filters.grid") == "filters"
+    assert layer_of("vc_gym.angles") == "base"
+    assert layer_of("vc_gym.filters.heading_grid") == "filters"
 
 
 def test_every_subpackage_has_a_layer():

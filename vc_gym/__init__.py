@@ -11,7 +11,7 @@ __version__ = "0.1.0"
 
 #: Registered environment ids -> (entry point, max_episode_steps).
 ENV_SPECS = {
-    "vc_gym/AiboRoom-v0": ("vc_gym.envs.aibo_room:AiboRoomEnv", 1000),
+    "vc_gym/AiboRoom-v0": ("vc_gym.sim.aibo_room:AiboRoomEnv", 1000),
     # ends itself: stop, fall, or its own homing/learning time limits
     "vc_gym/LearnThenHome-v0": ("vc_gym.envs.learn_then_home:LearnThenHomeEnv", None),
     # the task as a learned agent sees it: compass features in, (walk, turn, stop) out

@@ -9,7 +9,7 @@ import textwrap
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from vc_gym.experiments.output import write_json
+from vc_gym.jobs.output import write_json
 from vc_gym.validation import (
     MAX_EPISODES,
     MAX_HOMING_S,
@@ -97,8 +97,8 @@ _TRAIN_FIELDS = {
 
 
 def _train_sweep(args: argparse.Namespace, config, out: Path) -> int:
-    from vc_gym.experiments.runner import make_backend
-    from vc_gym.experiments.training_sweep import FIGURES, run_train_sweep
+    from vc_gym.jobs.runner import make_backend
+    from vc_gym.training.sweep import FIGURES, run_train_sweep
 
     with make_backend(args.backend, args.workers, args.address) as backend:
         r = run_train_sweep(out, config, args.seeds, backend, progress=not args.json)
@@ -116,7 +116,7 @@ def _train_sweep(args: argparse.Namespace, config, out: Path) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.training import TrainConfig, check_names, read_train_config, train
+    from vc_gym.training.train import TrainConfig, check_names, read_train_config, train
 
     given = {
         field: getattr(args, opt)
@@ -177,22 +177,22 @@ def _cmd_train(args: argparse.Namespace) -> int:
 def _check_bench_args(args: argparse.Namespace) -> None:
     """Every ``vc-gym bench`` argument its benchmark uses, then ``--out`` and ``--plot``,
     before any work (a bad file name fails now, not after the benchmark)."""
-    from vc_gym.experiments.output import check_out_file
+    from vc_gym.jobs.output import check_out_file
 
     int_in_range("--repeats", args.repeats, 1, MAX_BENCH_REPEATS)
     check_seed("--seed", args.seed)
     if args.what == "compass":
-        from vc_gym.experiments.bench_compass import MAX_FRAMES
+        from vc_gym.experiments.benchmarks.compass import MAX_FRAMES
 
         int_in_range("--frames", args.frames, 1, MAX_FRAMES)
     elif args.what == "backends":
-        from vc_gym.experiments.runner import check_workers
+        from vc_gym.jobs.runner import check_workers
 
         int_in_range("--episodes", args.episodes, 1, MAX_EPISODES)
         check_workers(args.workers, "--workers", minimum=2)
     elif args.what == "train":
-        from vc_gym.experiments.bench_train import MAX_TIMESTEPS
-        from vc_gym.experiments.runner import check_workers
+        from vc_gym.experiments.benchmarks.train import MAX_TIMESTEPS
+        from vc_gym.jobs.runner import check_workers
 
         int_in_range("--timesteps", args.timesteps, 1, MAX_TIMESTEPS)
         check_workers(args.n_envs, "--n-envs")
@@ -207,7 +207,7 @@ def _check_bench_args(args: argparse.Namespace) -> None:
 def _cmd_bench(args: argparse.Namespace) -> int:
     _check_bench_args(args)
     if args.what == "compass":
-        from vc_gym.experiments.bench_compass import bench_compass
+        from vc_gym.experiments.benchmarks.compass import bench_compass
 
         result = bench_compass(
             frames=args.frames, repeats=args.repeats, seed=args.seed, progress=not args.json
@@ -221,7 +221,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                 f"localize {result['paper_aibo_localize_ms']} ms"
             )
     elif args.what == "filters":
-        from vc_gym.experiments.bench_filters import bench_filters
+        from vc_gym.experiments.benchmarks.filters import bench_filters
 
         result = bench_filters(repeats=args.repeats, seed=args.seed, plot=args.plot)
         if not args.json:
@@ -234,7 +234,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                     f"max {v['max_error_deg']:6.1f}°"
                 )
     elif args.what == "env":
-        from vc_gym.experiments.bench_env import bench_env
+        from vc_gym.experiments.benchmarks.env import bench_env
 
         result = bench_env(rounds=max(1, args.repeats // 3), seed=args.seed)
         if not args.json:
@@ -245,7 +245,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                 f"2 sync envs: x{result['sync2_speedup']:.2f}"
             )
     elif args.what == "trackers":
-        from vc_gym.experiments.bench_trackers import bench_trackers
+        from vc_gym.experiments.benchmarks.trackers import bench_trackers
 
         result = bench_trackers(repeats=max(1, args.repeats // 3), seed=args.seed)
         if not args.json:
@@ -258,7 +258,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                     f"{v['final_position_error_m'] * 100:.0f} cm"
                 )
     elif args.what == "backends":
-        from vc_gym.experiments.bench_backends import bench_backends
+        from vc_gym.experiments.benchmarks.backends import bench_backends
 
         result = bench_backends(
             episodes=args.episodes, workers=args.workers, seed=args.seed, progress=not args.json
@@ -272,7 +272,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                 )
             print(f"byte-identical results.json on every backend: {result['identical_results']}")
     elif args.what == "train":
-        from vc_gym.experiments.bench_train import bench_train
+        from vc_gym.experiments.benchmarks.train import bench_train
 
         result = bench_train(
             timesteps=args.timesteps, n_envs=args.n_envs, seed=args.seed, progress=not args.json
@@ -307,9 +307,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def _cmd_experiment(args: argparse.Namespace) -> int:
     if args.name in ("synthetic-compass", "real-rotation"):
         return _cmd_compass_experiment(args)
-    from vc_gym.experiments.output import new_out_dir
-    from vc_gym.experiments.runner import make_backend
     from vc_gym.experiments.studies import ExperimentOptions, get_experiment
+    from vc_gym.jobs.output import new_out_dir
+    from vc_gym.jobs.runner import make_backend
 
     experiment = get_experiment(args.name)
     size = "quick" if args.quick else (args.size or "full")
@@ -334,7 +334,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     else:
         for line in experiment.summary_lines(results):
             print(line)
-        from vc_gym.experiments.output import read_json
+        from vc_gym.jobs.output import read_json
 
         run_info = read_json(out / "run.json") if (out / "run.json").is_file() else {}
         for line in experiment.cost_lines(run_info):
@@ -358,7 +358,7 @@ def _check_experiment_args(args: argparse.Namespace) -> None:
     checks its own settings again (and what only it knows) before its first job."""
     import os
 
-    from vc_gym.experiments.runner import check_workers
+    from vc_gym.jobs.runner import check_workers
 
     check_seed("--seed", args.seed)
     if getattr(args, "workers", None) is not None:
@@ -434,7 +434,7 @@ def _experiment_options(args: argparse.Namespace, run) -> dict:
 
 def _cmd_compass_experiment(args: argparse.Namespace) -> int:
     """The compass-only experiments (no simulator, no jobs)."""
-    from vc_gym.experiments.output import new_out_dir
+    from vc_gym.jobs.output import new_out_dir
 
     check_seed("--seed", args.seed)
     if args.name == "real-rotation":  # the photos are checked before the folder is made
@@ -510,7 +510,7 @@ class _SceneChoices:
         self.extra = extra
 
     def _names(self) -> tuple[str, ...]:
-        from vc_gym.envs.scenes import scene_names
+        from vc_gym.sim.scenes import scene_names
 
         return (*self.extra, *scene_names())
 
@@ -522,9 +522,9 @@ class _SceneChoices:
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
-    from vc_gym.envs.scenes import scene_names
-    from vc_gym.experiments.output import check_out_dir
     from vc_gym.experiments.render_scenes import render_scene_pictures
+    from vc_gym.jobs.output import check_out_dir
+    from vc_gym.sim.scenes import scene_names
 
     check_seed("--seed", args.seed)
     check_out_dir(args.out)
@@ -535,8 +535,8 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
 
 def _cmd_soak(args: argparse.Namespace) -> int:
-    from vc_gym.experiments.output import check_out_file
-    from vc_gym.experiments.soak import check_soak_args, soak
+    from vc_gym.experiments.benchmarks.soak import check_soak_args, soak
+    from vc_gym.jobs.output import check_out_file
 
     check_soak_args(
         args.steps,
@@ -570,9 +570,9 @@ def _cmd_soak(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
+    from vc_gym.experiments.benchmarks.soak import MAX_SOAK_STEPS, MIN_WINDOW, check_soak_args
     from vc_gym.experiments.check import run_check
-    from vc_gym.experiments.output import check_out_file
-    from vc_gym.experiments.soak import MAX_SOAK_STEPS, MIN_WINDOW, check_soak_args
+    from vc_gym.jobs.output import check_out_file
 
     # the soak's arguments before the cases run; its window is the one run_check uses
     steps = int_in_range("--soak-steps", args.soak_steps, 2 * MIN_WINDOW, MAX_SOAK_STEPS)
@@ -1205,7 +1205,7 @@ def _resume_hint(args: argparse.Namespace) -> str:
             return f"; rerun the same command to resume the sweep from the runs saved in {out}"
         out = args.resume or args.out or "vc_gym_agent"
         try:
-            from vc_gym.experiments.training import latest_checkpoint
+            from vc_gym.training.train import latest_checkpoint
 
             saved = latest_checkpoint(out) is not None
         except Exception:  # noqa: BLE001 - only a hint; the run is over either way

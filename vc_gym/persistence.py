@@ -237,7 +237,7 @@ def zip_entries_problem(
     decompressed): more than ``max_members`` entries (when given), a repeated entry
     name (a second entry hiding behind the first), an entry larger than ``max_entry``
     bytes or more than ``max_total`` in all. ``None`` if there is nothing; maps
-    (:func:`load_npz_checked`) and models (:mod:`vc_gym.agents.safe_load`) are both
+    (:func:`load_npz_checked`) and models (:mod:`vc_gym.training.safe_load`) are both
     checked with it."""
     if max_members is not None and len(infos) > max_members:
         return f"it holds {len(infos)} entries, more than {max_members}"

@@ -87,7 +87,7 @@ def test_shipped_policy_was_trained_with_the_default_settings():
     from dataclasses import replace
 
     from vc_gym.agents.learned import PRETRAINED_MODEL
-    from vc_gym.experiments.training import TrainConfig, read_train_config
+    from vc_gym.training.train import TrainConfig, read_train_config
 
     shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
     # the run measured its goal (centred); everything it was given is the defaults
@@ -148,7 +148,7 @@ def test_the_command_refuses_a_config_that_names_code(tmp_path, capsys):
 
 
 def test_an_import_path_is_read_when_the_user_allows_it(tmp_path):
-    spec = "vc_gym.localization.grid:GridTracker"
+    spec = "vc_gym.localization.grid_tracker:GridTracker"
     model, _ = _copied_agent(tmp_path, {"tracker": spec})
     with pytest.raises(ValueError, match="import path"):
         LearnedHomingAgent(model)
@@ -181,7 +181,7 @@ def test_the_command_line_can_allow_import_paths(tmp_path, monkeypatch, capsys):
         return {"overall": {}, "failed_jobs": []}
 
     monkeypatch.setattr(homing, "run_homing", fake_run_homing)
-    model, _ = _copied_agent(tmp_path, {"tracker": "vc_gym.localization.grid:GridTracker"})
+    model, _ = _copied_agent(tmp_path, {"tracker": "vc_gym.localization.grid_tracker:GridTracker"})
     argv = ["evaluate", "--agent", str(model), "--episodes", "1", "--out", str(tmp_path / "r")]
     assert main(argv) == 2
     assert "import path" in capsys.readouterr().err

@@ -10,9 +10,9 @@ from gymnasium import spaces
 
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.envs import PlacePool
-from vc_gym.envs.head_camera import HeadCameraSpec
 from vc_gym.envs.homing import PreviousAction, StopAction
 from vc_gym.envs.learning import LearningResult
+from vc_gym.sim.head_camera import HeadCameraSpec
 from vc_gym.validation import check_action, check_reset_options
 
 SMALL = HeadCameraSpec(52, 40, 56.9)

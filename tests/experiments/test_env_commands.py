@@ -5,7 +5,7 @@ from __future__ import annotations
 import cv2
 
 from vc_gym.cli import main
-from vc_gym.experiments.bench_env import bench_env
+from vc_gym.experiments.benchmarks.env import bench_env
 
 
 def test_render_writes_top_view_and_strip(tmp_path, capsys):

@@ -9,9 +9,9 @@ import pytest
 
 from vc_gym.experiments.demo import run_demo
 from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
-from vc_gym.experiments.runner import LocalBackend
 from vc_gym.experiments.studies import ExperimentOptions
 from vc_gym.experiments.studies.homing import run_homing
+from vc_gym.jobs.runner import LocalBackend
 
 SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
 

@@ -51,7 +51,7 @@ def test_every_experiment_wrote_its_files(paper_quick, name):
 
 def test_every_experiment_is_tested_end_to_end():
     # the paper report runs ORDER; the others have end-to-end tests of their own (agents:
-    # tests/experiments/test_training.py, it needs a trained model)
+    # tests/training/test_training.py, it needs a trained model)
     assert set(EXPERIMENTS) == {*ORDER, "paper", "localization", "agents"}
 
 
@@ -124,7 +124,7 @@ def test_homing_with_a_baseline_as_the_heading_sensor(homing_quick, tmp_path, se
         assert r["overall"]["mean_heading_error_deg"] < 15.0
         return
     (saved,) = (out / "sensors").glob("feature-robolab-seed0.npz")
-    from vc_gym.baselines import FeatureCompass, load_sensor
+    from vc_gym.heading_sensors import FeatureCompass, load_sensor
 
     assert isinstance(load_sensor("feature", saved), FeatureCompass)
     assert job["kwargs"]["tracker"]["sensor_file"] == str(saved.resolve())
@@ -281,7 +281,7 @@ def test_demo_rejects_bad_values_before_making_its_folder(tmp_path, capsys):
 
 
 def test_bench_backends_measures_every_backend_on_the_same_jobs():
-    from vc_gym.experiments.bench_backends import bench_backends
+    from vc_gym.experiments.benchmarks.backends import bench_backends
 
     r = bench_backends(episodes=2, learn_time_s=0.3, max_homing_s=8.0, progress=False)
     expected = {"local-1", "local-2"} | ({"ray-2"} if r["ray"] else set())

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vc_gym.compass import Camera
-from vc_gym.envs import AiboRoomEnv, LearningConfig, SpotLearning
+from vc_gym.envs import LearningConfig, SpotLearning
 from vc_gym.experiments.views import (
     COMPASS,
     distance_table,
@@ -20,6 +20,7 @@ from vc_gym.experiments.views import (
     view_poses,
 )
 from vc_gym.localization import ParticleTracker
+from vc_gym.sim import AiboRoomEnv
 
 #: robolab's field and the centre of its rear half (the paper's training spot, 5.1)
 FIELD = (-3.0, 3.0, -2.0, 2.0)

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.filters.grid import UNIFORM_SPREAD_DEG, HeadingGridFilter
-from vc_gym.filters.kalman import KalmanHeadingFilter
-from vc_gym.filters.particle import MAX_PARTICLES, ParticleFilter
-from vc_gym.filters.sensors import VonMisesHeadingSensor
+from vc_gym.filters.heading_grid import UNIFORM_SPREAD_DEG, HeadingGridFilter
+from vc_gym.filters.heading_kalman import KalmanHeadingFilter
+from vc_gym.filters.particle_filter import MAX_PARTICLES, ParticleFilter
+from vc_gym.filters.synthetic_sensors import VonMisesHeadingSensor
 from vc_gym.filters.translational import TranslationalFilter, weighted_spot_position
 
 BAD = (1e308, float("inf"), float("nan"))

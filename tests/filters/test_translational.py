@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from vc_gym.filters.grid import mixing_lambda
+from vc_gym.filters.heading_grid import mixing_lambda
 from vc_gym.filters.translational import TranslationalFilter, weighted_spot_position
 
 SPOTS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])

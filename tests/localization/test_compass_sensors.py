@@ -7,8 +7,8 @@ import pytest
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera
-from vc_gym.filters.grid import HeadingGridFilter
-from vc_gym.filters.protocol import HeadingSensor, PoseSensor
+from vc_gym.filters.heading_grid import HeadingGridFilter
+from vc_gym.filters.sensor_protocol import HeadingSensor, PoseSensor
 from vc_gym.localization import CompassHeadingSensor
 from vc_gym.worlds.panorama import render_view
 
@@ -62,7 +62,7 @@ def test_compass_sensor_interpolates_between_grid_points(room_pano, room_compass
 
 
 def test_tempered_distribution_known_answers():
-    from vc_gym.localization.sensors import tempered_distribution
+    from vc_gym.localization.compass_sensors import tempered_distribution
 
     ll = np.array([0.0, np.log(4.0), -np.inf])  # the last state ruled out
     np.testing.assert_allclose(tempered_distribution(ll, 1.0), [0.2, 0.8, 0.0])

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from vc_gym.filters.particle import MAX_PARTICLES
-from vc_gym.localization.particle import ParticleTracker
+from vc_gym.filters.particle_filter import MAX_PARTICLES
+from vc_gym.localization.particle_tracker import ParticleTracker
 
 
 def test_a_billion_particles_is_a_value_error_at_construction():

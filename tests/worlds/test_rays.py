@@ -32,7 +32,7 @@ def test_image_edges_look_half_the_field_of_view_aside() -> None:
 
 
 def test_columns_follow_the_design_convention_at_zero_pitch() -> None:
-    # DESIGN.md: direction(u) = yaw - degrees(atan((u - cx) / f)), f = (W/2) / tan(hfov/2)
+    # docs/design.md: direction(u) = yaw - degrees(atan((u - cx) / f)), f = (W/2) / tan(hfov/2)
     hfov, w, h = 70.0, 160, 90
     cam = Camera(hfov_deg=hfov)
     f = (w / 2) / math.tan(math.radians(hfov / 2))

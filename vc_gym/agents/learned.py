@@ -3,7 +3,7 @@
 A learned agent sees what :class:`~vc_gym.envs.CompassObservation` adds (the tracker's
 heading and position estimates, the spots' goodness), never the camera frame or the
 true pose: it acts on ``vc_gym/Homing-v0`` (:mod:`vc_gym.envs.homing`). Training lives
-in :mod:`vc_gym.experiments.training` (``vc-gym train``); this module loads what it
+in :mod:`vc_gym.training.train` (``vc-gym train``); this module loads what it
 wrote.
 """
 
@@ -16,11 +16,12 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
 from vc_gym.config_files import read_settings
-from vc_gym.envs.scenes.registry import check_scene_name
 from vc_gym.localization.registry import TRACKERS
 from vc_gym.plugins import check_file_spec, check_plain_data
+from vc_gym.sim.scenes.registry import check_scene_name
+from vc_gym.training.algorithms import ALGORITHMS, algorithm_class
+from vc_gym.training.safe_load import UnsafeModelError, load_sb3_model
 
 __all__ = [
     "ALGORITHMS",
@@ -31,8 +32,6 @@ __all__ = [
     "algorithm_class",
     "read_agent_config",
 ]
-
-ALGORITHMS = ("ppo", "sac")
 
 #: Keys of a schema-1 ``config.json`` that are ``vc_gym/Homing-v0`` arguments (schema 2
 #: stores them under ``"env"``).
@@ -62,18 +61,6 @@ CONFIG_ENV_KEYS = (
 #: The PPO policy shipped with the package (trained by ``vc-gym train``, see README);
 #: ``vc-gym evaluate --agent pretrained`` evaluates it.
 PRETRAINED_MODEL = Path(__file__).parent / "pretrained" / "ppo_robolab" / "model.zip"
-
-
-def algorithm_class(name: str):
-    """The stable-baselines3 class of ``"ppo"`` or ``"sac"``."""
-    if name not in ALGORITHMS:
-        raise ValueError(f"algo must be one of {ALGORITHMS}, got {name!r}")
-    try:
-        from stable_baselines3 import PPO, SAC
-    except ImportError as exc:
-        raise ValueError("learned agents need stable-baselines3: pip install 'vc_gym[rl]'") from exc
-
-    return {"ppo": PPO, "sac": SAC}[name]
 
 
 def read_agent_config(path: Path, allow_imports: bool = False) -> tuple[str, dict[str, Any]]:
@@ -124,7 +111,7 @@ class LearnedHomingAgent:
     Parameters
     ----------
     model_path : path
-        The ``model.zip`` written by :func:`vc_gym.experiments.training.train`.
+        The ``model.zip`` written by :func:`vc_gym.training.train.train`.
     allow_imports : bool
         Let the ``config.json`` name a tracker by import path (``"module:attr"``), which
         imports that module: only for files you trust (:func:`read_agent_config`).

@@ -76,7 +76,7 @@ class ScriptedHomingPolicy:
         The goal, relative to the tracker's home (world frame, metres): the policy walks
         to and stops where the estimate reads this. Default ``(0, 0)``, the paper's. A
         learned agent's training measures one (``home_offset_m`` of its
-        ``config.json``, :mod:`vc_gym.experiments.home_offset`); giving the scripted
+        ``config.json``, :mod:`vc_gym.training.home_offset`); giving the scripted
         agent the same shows what the goal alone is worth.
     """
 

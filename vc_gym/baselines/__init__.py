@@ -1,56 +1,16 @@
-"""Other heading sensors under the visual compass' protocol (the paper's section 6).
+"""Deprecated alias of :mod:`vc_gym.heading_sensors` (kept for one release).
 
-Each learns at a spot from frames with a known yaw and answers a log-likelihood over
-headings, like :class:`~vc_gym.compass.VisualCompass` (the
-:class:`~vc_gym.compass.ImageCompass` surface), so the same filters, trackers and
-experiments take them (``vc-gym experiment sensors``):
-
-* :class:`ImageDifferenceCompass` — the rotational image difference (Zeil et al.;
-  Labrosse's visual compass), every shift at once by FFT;
-* :class:`SectorColourCompass` — mean colour per sector (Porta & Kröse);
-* :class:`FeatureCompass` — ORB keypoints learned with their direction;
-* :class:`NoisyMagneticCompass` — a magnetometer: true heading, noise and a local
-  disturbance field (no camera).
-
-The tracker ``{"type": SENSOR_GRID, "sensor": name, "sensor_file": path}`` is the grid
-tracker with a saved image sensor as its heading sensor.
-
->>> from vc_gym.baselines import make_sensor                          # doctest: +SKIP
->>> sensor = make_sensor("image_difference")                         # doctest: +SKIP
->>> for image, yaw in frames: sensor.learn(image, Camera(yaw_deg=yaw))  # doctest: +SKIP
->>> sensor.estimate(new_image, Camera()).heading_deg                 # doctest: +SKIP
+The other heading sensors moved to :mod:`vc_gym.heading_sensors`, a name that does not
+read as reinforcement-learning baselines.
 """
 
-from vc_gym.baselines.base import BaselineCompass, FrameScore
-from vc_gym.baselines.feature import FeatureCompass
-from vc_gym.baselines.image_difference import ImageDifferenceCompass
-from vc_gym.baselines.magnetic import DisturbanceSource, MagnetometerCompass, NoisyMagneticCompass
-from vc_gym.baselines.registry import SENSORS, make_sensor, register_sensor
-from vc_gym.baselines.sector_colour import SectorColourCompass
-from vc_gym.baselines.strip import StripGrid, angular_strip
-from vc_gym.baselines.tracking import (
-    IMAGE_SENSORS,
-    SENSOR_GRID,
-    load_sensor,
-    sensor_grid_tracker,
-)
+import warnings
 
-__all__ = [
-    "IMAGE_SENSORS",
-    "SENSORS",
-    "SENSOR_GRID",
-    "BaselineCompass",
-    "DisturbanceSource",
-    "FeatureCompass",
-    "FrameScore",
-    "ImageDifferenceCompass",
-    "MagnetometerCompass",
-    "NoisyMagneticCompass",
-    "SectorColourCompass",
-    "StripGrid",
-    "angular_strip",
-    "load_sensor",
-    "make_sensor",
-    "register_sensor",
-    "sensor_grid_tracker",
-]
+from vc_gym.heading_sensors import *  # noqa: F403
+from vc_gym.heading_sensors import __all__  # noqa: F401
+
+warnings.warn(
+    "vc_gym.baselines is deprecated: import vc_gym.heading_sensors instead",
+    DeprecationWarning,
+    stacklevel=2,
+)

@@ -1,6 +1,6 @@
 """Pinhole camera model of the compass: which direction each image column looks at.
 
-Conventions (DESIGN.md): yaw in degrees, counter-clockwise positive seen from above;
+Conventions (docs/design.md): yaw in degrees, counter-clockwise positive seen from above;
 ``yaw`` is the direction of the optical axis, which is the centre column unless a
 principal point is given. A column right of the principal point looks at a *smaller*
 yaw: ``direction(u) = yaw - degrees(atan((u - cx) / f))`` with

@@ -1,8 +1,8 @@
 """What every image compass offers: the visual compass and the baselines alike.
 
-A tracker's heading sensor (:class:`~vc_gym.localization.sensors.CompassHeadingSensor`),
+A tracker's heading sensor (:class:`~vc_gym.localization.compass_sensors.CompassHeadingSensor`),
 the experiments and a user's own code need only this surface, so a baseline compass
-(:mod:`vc_gym.baselines`) or a user's own model plugs in wherever the visual compass does.
+(:mod:`vc_gym.heading_sensors`) or a user's own model plugs in wherever the visual compass does.
 """
 
 from __future__ import annotations

@@ -1,12 +1,17 @@
-"""The simulated world: PyBullet scenes, the quadruped, its head camera, Gymnasium envs.
+"""The tasks on the simulated world: learn a place, then walk home.
 
-Importing this package imports PyBullet; ``import vc_gym`` alone registers the envs
-without it.
+* :class:`LearnThenHomeEnv` (``vc_gym/LearnThenHome-v0``) -- the paper's task: a
+  learning phase (a :class:`Learner` the task is given) and a homing phase;
+* ``vc_gym/Homing-v0`` (:func:`make_homing_env`) -- the homing phase as a learned agent
+  sees it: compass features in, (walk, turn, stop) out;
+* :mod:`vc_gym.envs.wrappers` -- observation wrappers (:class:`CompassObservation`).
+
+The world itself (robot, scenes, camera, ``vc_gym/AiboRoom-v0``) is :mod:`vc_gym.sim`.
 """
 
-from vc_gym.envs.aibo_room import AiboRoomEnv
-from vc_gym.envs.compass_observation import CompassObservation
-from vc_gym.envs.head_camera import HeadCameraSpec, render_camera
+import warnings
+from typing import Any
+
 from vc_gym.envs.homing import HomingFeatures, PreviousAction, StopAction, make_homing_env
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.learning import (
@@ -21,44 +26,53 @@ from vc_gym.envs.learning import (
     kidnap_pose,
 )
 from vc_gym.envs.place_pool import PlacePool
-from vc_gym.envs.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
-from vc_gym.envs.scenes import (
-    SCENES,
-    Scene,
-    build_scene,
-    register_scene,
-    scene_names,
-    unregister_scene,
-)
+from vc_gym.envs.wrappers import CompassObservation
 
-__all__ = [
+#: Names that moved to :mod:`vc_gym.sim`; importing them from here still works, with a
+#: DeprecationWarning, for one release.
+_MOVED_TO_SIM = {
     "LOCOMOTION_MODES",
     "SCENES",
     "AiboRoomEnv",
+    "HeadCameraSpec",
+    "OdometryNoise",
+    "Quadruped",
+    "Scene",
+    "build_scene",
+    "register_scene",
+    "render_camera",
+    "scene_names",
+    "unregister_scene",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _MOVED_TO_SIM:
+        import vc_gym.sim
+
+        warnings.warn(
+            f"vc_gym.envs.{name} moved to vc_gym.sim.{name}", DeprecationWarning, stacklevel=2
+        )
+        return getattr(vc_gym.sim, name)
+    raise AttributeError(f"module 'vc_gym.envs' has no attribute {name!r}")
+
+
+__all__ = [
     "CompassObservation",
     "GridLearning",
-    "HeadCameraSpec",
     "HomingFeatures",
-    "PreviousAction",
     "LEARNING_MODES",
     "LearnThenHomeEnv",
     "Learner",
     "LearningConfig",
     "LearningResult",
-    "OdometryNoise",
     "PlacePool",
-    "Quadruped",
+    "PreviousAction",
     "RobotFell",
-    "Scene",
     "ScriptedLearner",
     "ScriptedLearning",
     "SpotLearning",
     "StopAction",
-    "build_scene",
     "kidnap_pose",
     "make_homing_env",
-    "register_scene",
-    "render_camera",
-    "scene_names",
-    "unregister_scene",
 ]

@@ -16,8 +16,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from vc_gym.envs.compass_observation import CompassObservation
 from vc_gym.envs.learning import HEAD_SCAN_DEG
+from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
 from vc_gym.validation import (
     check_action,
@@ -28,6 +28,7 @@ from vc_gym.validation import (
 )
 
 __all__ = [
+    "LEARNED_CONFIRM_STOP_M",
     "MAX_HOME_OFFSET_M",
     "STOP_THRESHOLD",
     "HomingFeatures",
@@ -39,6 +40,11 @@ __all__ = [
 ]
 
 STOP_THRESHOLD = 0.5
+#: How far (metres) a learned agent's stop may be from where the tracker put home while it
+#: stands for the task's stop time before its walk resumes: :class:`StopAction`'s
+#: ``confirm_stop_m`` in training and in every evaluation, as the scripted agent checks
+#: its own stops (``rearm_factor × home_tolerance_m`` = 0.25 m).
+LEARNED_CONFIRM_STOP_M = 0.25
 #: Largest ``home_offset_m`` accepted (metres): a correction of the tracker's home, not
 #: another goal (the success radius is 0.3 m).
 MAX_HOME_OFFSET_M = 1.0
@@ -83,7 +89,7 @@ class HomingFeatures(gym.ObservationWrapper):
     is measured from there. A learned agent trained with it walks to, and stops at,
     that point of its tracker's estimate, which ``vc-gym train --home-offset-episodes N``
     can measure so that the expert's stops centre on the true home
-    (:mod:`vc_gym.experiments.home_offset`). Default ``(0, 0)``.
+    (:mod:`vc_gym.training.home_offset`). Default ``(0, 0)``.
     """
 
     HOME_VECTOR = slice(0, 2)

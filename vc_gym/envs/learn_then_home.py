@@ -13,7 +13,6 @@ import numpy as np
 from gymnasium import spaces
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.envs.aibo_room import RESET_OPTIONS, AiboRoomEnv
 from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.envs.learning import (
     HOME,
@@ -26,6 +25,7 @@ from vc_gym.envs.learning import (
     paper_spots,
 )
 from vc_gym.poses import compose
+from vc_gym.sim.aibo_room import RESET_OPTIONS, AiboRoomEnv
 from vc_gym.validation import (
     check_action,
     check_reset_options,
@@ -286,7 +286,7 @@ class LearnThenHomeEnv(gym.Env):
         return bool(np.all(np.abs(np.asarray(action)[:3]) <= self.still_threshold))
 
     def velocity_action(self, **velocities: float) -> np.ndarray:
-        """The room's :meth:`~vc_gym.envs.AiboRoomEnv.velocity_action` (``Box(5)``)."""
+        """The room's :meth:`~vc_gym.sim.AiboRoomEnv.velocity_action` (``Box(5)``)."""
         return self.room.velocity_action(**velocities)
 
     def _kidnap(self, options: dict[str, Any], seed: int | None = None) -> tuple[dict, dict]:

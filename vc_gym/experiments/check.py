@@ -9,7 +9,7 @@ its job within seconds. The env suite does the same misuse to every registered
 ``vc_gym/`` env (a new env is covered without a new case). A case fails if anything
 else happens: another exception, no exception, a hang (each case has a time limit), or
 code from a file running. The soak suite reports the speed and memory figures of a
-short :func:`~vc_gym.experiments.soak.soak`.
+short :func:`~vc_gym.experiments.benchmarks.soak.soak`.
 """
 
 from __future__ import annotations
@@ -32,19 +32,19 @@ import numpy as np
 from tqdm import tqdm
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.agents.safe_load import UnsafeModelError, load_sb3_model
-from vc_gym.baselines import load_sensor, make_sensor
 from vc_gym.compass import Camera, CompassConfig, VisualCompass
 from vc_gym.config_files import read_settings
 from vc_gym.errors import MapFileError, NotLearnedError
+from vc_gym.experiments.benchmarks.soak import soak
 from vc_gym.experiments.check_case import Case, raises
 from vc_gym.experiments.check_security import model_with_data, security_cases
-from vc_gym.experiments.runner import ExperimentRun, Job, LocalBackend
-from vc_gym.experiments.soak import soak
-from vc_gym.experiments.training import TrainConfig
 from vc_gym.filters import KalmanHeadingFilter, ParticleFilter, TranslationalFilter
+from vc_gym.heading_sensors import load_sensor, make_sensor
+from vc_gym.jobs.runner import ExperimentRun, Job, LocalBackend
 from vc_gym.localization import make_tracker
 from vc_gym.persistence import load_npz_checked, save_npz_atomic
+from vc_gym.training.safe_load import UnsafeModelError, load_sb3_model
+from vc_gym.training.train import TrainConfig
 from vc_gym.worlds.panorama import make_panorama, render_view
 
 __all__ = ["Case", "all_cases", "run_check"]

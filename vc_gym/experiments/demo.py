@@ -16,15 +16,15 @@ from pathlib import Path
 import numpy as np
 
 from vc_gym.envs.learning import LearningResult, ScriptedLearning
-from vc_gym.envs.top_view import TopView
 from vc_gym.experiments.episode import (
     HOMING_MODES,
     EpisodeRecord,
     make_homing_run,
     run_episode,
 )
-from vc_gym.experiments.output import new_figure, new_out_dir, save_figure, write_json
+from vc_gym.jobs.output import new_figure, new_out_dir, save_figure, write_json
 from vc_gym.localization import TrackerSpec, make_tracker
+from vc_gym.sim.top_view import TopView
 from vc_gym.validation import (
     MAX_HOMING_S,
     MAX_LEARN_TIME_S,

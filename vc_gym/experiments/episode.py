@@ -24,7 +24,8 @@ from tqdm import tqdm
 from vc_gym.agents.learned import LearnedHomingAgent
 from vc_gym.agents.scripted import ScriptedHomingPolicy
 from vc_gym.angles import wrap180
-from vc_gym.envs.compass_observation import CompassObservation
+from vc_gym.envs.homing import LEARNED_CONFIRM_STOP_M
+from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
 
 __all__ = [
@@ -38,14 +39,6 @@ __all__ = [
     "homing_mode",
     "run_episode",
 ]
-
-
-#: A learned agent's stop is checked while it stands for the task's 5 s, as the scripted
-#: agent checks its own (its walk resumes beyond ``rearm_factor × home_tolerance_m`` =
-#: 0.25 m): :class:`~vc_gym.envs.StopAction`'s ``confirm_stop_m``. On 99 held-out
-#: kidnappings it took the three PPO policies trained with final stops from 82 ± 2 % to
-#: 86 ± 6 % success (README). Training checks stops the same way (``TrainConfig``).
-LEARNED_CONFIRM_STOP_M = 0.25
 
 
 @dataclass

@@ -9,10 +9,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from vc_gym.envs.aibo_room import AiboRoomEnv
-from vc_gym.envs.scenes import check_scene_name, scene_names
-from vc_gym.experiments.output import check_out_dir
+from vc_gym.jobs.output import check_out_dir
 from vc_gym.persistence import write_atomic
+from vc_gym.sim.aibo_room import AiboRoomEnv
+from vc_gym.sim.scenes import check_scene_name, scene_names
 
 __all__ = ["render_scene_pictures"]
 
@@ -44,7 +44,7 @@ def render_scene_pictures(
         Output folder (created if missing).
     scenes : str or sequence of str, optional
         Registered scene name(s); default: every registered scene
-        (:func:`vc_gym.envs.scenes.scene_names`). All are checked before anything is
+        (:func:`vc_gym.sim.scenes.scene_names`). All are checked before anything is
         rendered.
     seed : int
         Reset seed (and scene seed when ``randomize``).

@@ -20,8 +20,8 @@ from tqdm import tqdm
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
-from vc_gym.experiments.output import new_figure, save_figure, write_json
 from vc_gym.exposure import SessionLight
+from vc_gym.jobs.output import new_figure, save_figure, write_json
 from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
 
 __all__ = ["run_synthetic_compass"]

@@ -2,7 +2,7 @@
 
 :class:`EpisodeVideo` is an ``on_step`` hook of :func:`~vc_gym.experiments.episode.run_episode`.
 Each frame shows the robot's head-camera image beside a top view of the scene
-(:class:`~vc_gym.envs.top_view.TopView`, north up) with the true pose (red body, white
+(:class:`~vc_gym.sim.top_view.TopView`, north up) with the true pose (red body, white
 heading arrow, the camera's field of view, orange trail), the tracker's estimated pose
 (cyan ring with a heading arrow, its 1σ position uncertainty as an ellipse, cyan trail),
 home and the training spots, above a caption with the time, the heading error and the
@@ -25,9 +25,9 @@ import gymnasium as gym
 import numpy as np
 
 from vc_gym.angles import wrap180
-from vc_gym.envs.top_view import TopView
 from vc_gym.experiments.episode import EpisodeRecord, EpisodeStep, HomingRun, run_episode
 from vc_gym.persistence import write_atomic
+from vc_gym.sim.top_view import TopView
 
 __all__ = ["ESTIMATE_RGB", "TRUE_RGB", "EpisodeVideo", "write_episode_video"]
 
@@ -64,7 +64,7 @@ class EpisodeVideo:
     The camera image comes from the observation when it carries one
     (``make_homing_run(..., keep_image=True)``); otherwise (a learned agent's feature
     vector, or ``keep_image=False``) the head camera is rendered again from the env's
-    room, :meth:`~vc_gym.envs.AiboRoomEnv.head_image`: the same pixels (the renderer
+    room, :meth:`~vc_gym.sim.AiboRoomEnv.head_image`: the same pixels (the renderer
     is deterministic and draws no random numbers) for one more render per frame.
 
     Parameters

@@ -12,7 +12,7 @@ call (its result depends on its arguments, seeds included, never on what the sam
 process computed before):
 
 * :func:`field_grid` and :func:`view_poses`: where the robot is put;
-* :func:`look`: reset an :class:`~vc_gym.envs.aibo_room.AiboRoomEnv` at a pose and let
+* :func:`look`: reset an :class:`~vc_gym.sim.aibo_room.AiboRoomEnv` at a pose and let
   the robot stand there, scanning with its head, for some frames;
 * :func:`evaluate_view`: feed the frames to every tracker and record what each
   believed (and the single-frame compass of the atlas' first spot);
@@ -44,11 +44,11 @@ from matplotlib.patches import Circle, Rectangle
 
 from vc_gym.angles import wrap180, wrap360
 from vc_gym.compass import Camera, CompassAtlas
-from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.learning import HEAD_SCAN_DEG, RobotFell
-from vc_gym.experiments.output import new_figure, save_figure
+from vc_gym.jobs.output import new_figure, save_figure
 from vc_gym.localization import TrackerSpec, make_tracker
 from vc_gym.poses import check_pose
+from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.validation import finite_float, positive_float
 
 __all__ = [

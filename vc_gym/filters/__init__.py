@@ -7,11 +7,11 @@ The compass does through :class:`vc_gym.localization.CompassHeadingSensor` and
 """
 
 from vc_gym.filters.estimates import HeadingEstimate
-from vc_gym.filters.grid import RULES, HeadingGridFilter, mixing_lambda
-from vc_gym.filters.kalman import KalmanHeadingFilter
-from vc_gym.filters.particle import ParticleFilter, PoseEstimate
-from vc_gym.filters.protocol import HeadingSensor, PoseSensor, check_log_likelihood
-from vc_gym.filters.sensors import GaussianPoseSensor, VonMisesHeadingSensor
+from vc_gym.filters.heading_grid import RULES, HeadingGridFilter, mixing_lambda
+from vc_gym.filters.heading_kalman import KalmanHeadingFilter
+from vc_gym.filters.particle_filter import ParticleFilter, PoseEstimate
+from vc_gym.filters.sensor_protocol import HeadingSensor, PoseSensor, check_log_likelihood
+from vc_gym.filters.synthetic_sensors import GaussianPoseSensor, VonMisesHeadingSensor
 from vc_gym.filters.translational import TranslationalFilter, weighted_spot_position
 
 __all__ = [

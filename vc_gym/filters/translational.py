@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from vc_gym.filters.grid import mixing_lambda
+from vc_gym.filters.heading_grid import mixing_lambda
 from vc_gym.validation import MAX_ABS_METRES
 
 __all__ = ["MAX_GOODNESS", "TranslationalFilter", "weighted_spot_position"]

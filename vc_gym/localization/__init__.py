@@ -27,18 +27,18 @@ callable; :func:`register_tracker` adds a name.
 >>> state = tracker.update(image, head_pan_deg=20.0, odometry=(0.02, 0.0, 1.5))  # doctest: +SKIP
 """
 
-from vc_gym.localization.grid import GridTracker
-from vc_gym.localization.kalman import KalmanTracker
-from vc_gym.localization.particle import ParticleTracker
-from vc_gym.localization.position import AtlasPositionFilter
-from vc_gym.localization.protocol import Tracker, TrackerState
-from vc_gym.localization.registry import TRACKERS, TrackerSpec, make_tracker, register_tracker
-from vc_gym.localization.sensors import (
+from vc_gym.localization.compass_sensors import (
     AtlasPoseSensor,
     CompassHeadingSensor,
     best_spot_heading_log_likelihood,
 )
+from vc_gym.localization.grid_tracker import GridTracker
+from vc_gym.localization.kalman_tracker import KalmanTracker
+from vc_gym.localization.particle_tracker import ParticleTracker
+from vc_gym.localization.position import AtlasPositionFilter
+from vc_gym.localization.registry import TRACKERS, TrackerSpec, make_tracker, register_tracker
 from vc_gym.localization.shortlist import SpotShortlist
+from vc_gym.localization.tracker_protocol import Tracker, TrackerState
 
 __all__ = [
     "TRACKERS",

@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from vc_gym.localization.grid import GridTracker
-from vc_gym.localization.kalman import KalmanTracker
-from vc_gym.localization.particle import ParticleTracker
-from vc_gym.localization.protocol import Tracker
+from vc_gym.localization.grid_tracker import GridTracker
+from vc_gym.localization.kalman_tracker import KalmanTracker
+from vc_gym.localization.particle_tracker import ParticleTracker
+from vc_gym.localization.tracker_protocol import Tracker
 from vc_gym.plugins import make_plugin, register_plugin
 
 __all__ = ["TRACKERS", "TrackerSpec", "make_tracker", "register_tracker"]

@@ -11,9 +11,9 @@ known. This package makes them with numpy and OpenCV only (no PyBullet):
   and a 2.5-D ray caster that renders it from any position (:func:`render_room_view`):
   translation too, with parallax;
 * :mod:`vc_gym.worlds.rays`: the per-pixel camera rays both renderers cast
-  (:func:`ray_grid`, DESIGN.md's pinhole convention);
+  (:func:`ray_grid`, docs/design.md's pinhole convention);
 * :mod:`vc_gym.worlds.paint`: the colour and noise helpers every painter uses, also the
-  PyBullet scene textures of :mod:`vc_gym.envs.textures`.
+  PyBullet scene textures of :mod:`vc_gym.sim.textures`.
 
 Every scene depends only on the ``numpy.random.Generator`` passed in.
 

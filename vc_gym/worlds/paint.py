@@ -1,7 +1,7 @@
 """Colour and noise helpers shared by every painter of vc_gym's worlds and textures.
 
 The procedural panoramas (:mod:`vc_gym.worlds.panorama`), the ray-cast room
-(:mod:`vc_gym.worlds.room`) and the PyBullet scene textures (:mod:`vc_gym.envs.textures`)
+(:mod:`vc_gym.worlds.room`) and the PyBullet scene textures (:mod:`vc_gym.sim.textures`)
 all paint with these:
 
 * :func:`hsv` and :func:`random_colour`: colours as ``(3,)`` ``float32`` RGB in 0..255;

@@ -12,7 +12,7 @@ counter-clockwise from it, ``up``)::
     left    = -x
 
 so the ray looks at azimuth ``yaw + atan2(left, forward)`` and elevation
-``atan2(up, hypot(forward, left))`` (degrees). At zero pitch this is DESIGN.md's
+``atan2(up, hypot(forward, left))`` (degrees). At zero pitch this is docs/design.md's
 ``direction(u) = yaw - degrees(atan((u - cx) / f))``: a column right of the principal
 point looks at a *smaller* yaw. :meth:`Camera.column_offsets_deg` is the azimuth part at
 one row.

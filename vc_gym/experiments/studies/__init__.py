@@ -1,7 +1,7 @@
 """The paper's experiments and the tracker benchmark, as resumable job-based commands.
 
 Each experiment is a function ``run_<name>(out_dir, opts, **options) -> results`` that
-splits its work into jobs (:mod:`vc_gym.experiments.runner`), writes
+splits its work into jobs (:mod:`vc_gym.jobs.runner`), writes
 ``DIR/results.json`` (figures only), ``DIR/run.json`` (timings, backend, versions) and
 its PNGs, and a function ``summary_lines(results)`` that says the result in a few
 lines. :data:`EXPERIMENTS` maps the names of ``vc-gym experiment NAME`` to them.

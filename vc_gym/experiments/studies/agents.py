@@ -20,9 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.experiments.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.homing import PAPER_MEAN_CM, PAPER_STD_CM, mean_std, run_homing
+from vc_gym.jobs.output import check_out_dir, new_figure, save_figure, write_json
 
 __all__ = ["agent_list", "run_agents", "summary_lines"]
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.experiments.runner import ExperimentRun, LocalBackend, RayBackend, make_backend
+from vc_gym.jobs.runner import ExperimentRun, LocalBackend, RayBackend, make_backend
 
 __all__ = ["SIZES", "ExperimentOptions", "median_timings", "open_run", "pick_size"]
 
@@ -78,8 +78,8 @@ def open_run(
 
 def scene_field_bounds(scene: str) -> tuple[float, float, float, float]:
     """``(x0, x1, y0, y1)`` of a registered scene's field (builds the scene once)."""
-    from vc_gym.envs.aibo_room import AiboRoomEnv
-    from vc_gym.envs.scenes import check_scene_name
+    from vc_gym.sim.aibo_room import AiboRoomEnv
+    from vc_gym.sim.scenes import check_scene_name
 
     check_scene_name(scene)
     room = AiboRoomEnv(scene=scene)

@@ -22,21 +22,11 @@ from typing import Any
 import numpy as np
 
 from vc_gym.agents.learned import PRETRAINED_MODEL, LearnedHomingAgent
-from vc_gym.baselines import (
-    IMAGE_SENSORS,
-    SENSOR_GRID,
-    MagnetometerCompass,
-    NoisyMagneticCompass,
-)
 from vc_gym.compass import Camera, CompassAtlas
-from vc_gym.envs.aibo_room import AiboRoomEnv
 from vc_gym.envs.homing import home_offset
 from vc_gym.envs.learning import HOME
-from vc_gym.envs.scenes import check_scene_name
 from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.episode import HOMING_MODES, homing_mode, make_homing_run, run_episode
-from vc_gym.experiments.output import new_figure, save_figure
-from vc_gym.experiments.runner import Job, worker_cache
 from vc_gym.experiments.spot_sensors import spot_sensor_job
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
@@ -46,7 +36,17 @@ from vc_gym.experiments.studies.common import (
 )
 from vc_gym.experiments.video import write_episode_video
 from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
+from vc_gym.heading_sensors import (
+    IMAGE_SENSORS,
+    SENSOR_GRID,
+    MagnetometerCompass,
+    NoisyMagneticCompass,
+)
+from vc_gym.jobs.output import new_figure, save_figure
+from vc_gym.jobs.runner import Job, worker_cache
 from vc_gym.localization import make_tracker
+from vc_gym.sim.aibo_room import AiboRoomEnv
+from vc_gym.sim.scenes import check_scene_name
 from vc_gym.validation import flag, positive_float
 
 __all__ = [
@@ -306,12 +306,12 @@ def run_homing(
         ``"paper"`` or ``"improved"`` (:data:`MODES`: how the place is learned and how
         the scripted agent homes).
     sensor : str, optional
-        An image sensor of :data:`vc_gym.baselines.IMAGE_SENSORS` (``"feature"``,
+        An image sensor of :data:`vc_gym.heading_sensors.IMAGE_SENSORS` (``"feature"``,
         ``"image_difference"``, ...) as the grid tracker's heading sensor: for every
         learning seed it learns a turn at home with the true yaws
         (:data:`SENSOR_FRAMES` frames per direction) and is saved in ``DIR/sensors``;
         position still comes from the atlas. ``"magnetic"``: a magnetometer in the
-        robot's head (:class:`~vc_gym.baselines.MagnetometerCompass`, nothing learned).
+        robot's head (:class:`~vc_gym.heading_sensors.MagnetometerCompass`, nothing learned).
         Needs the grid tracker.
     home_offset_m : (float, float), optional
         The scripted agent's goal relative to the tracker's home (world frame, m;

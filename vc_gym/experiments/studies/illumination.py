@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     open_run,
@@ -30,6 +29,7 @@ from vc_gym.experiments.studies.orientation import (
     views_summary,
 )
 from vc_gym.experiments.views import COMPASS
+from vc_gym.jobs.output import new_figure, save_figure
 
 __all__ = ["LEVELS", "MODES", "run_illumination", "summary_lines"]
 

@@ -49,9 +49,6 @@ from typing import Any
 import numpy as np
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.envs.aibo_room import AiboRoomEnv
-from vc_gym.experiments.output import new_figure, save_figure
-from vc_gym.experiments.runner import Job, worker_cache
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     open_run,
@@ -60,6 +57,9 @@ from vc_gym.experiments.studies.common import (
 )
 from vc_gym.experiments.studies.orientation import one_scene
 from vc_gym.experiments.views import field_grid, look, view_poses
+from vc_gym.jobs.output import new_figure, save_figure
+from vc_gym.jobs.runner import Job, worker_cache
+from vc_gym.sim.aibo_room import AiboRoomEnv
 
 __all__ = [
     "calibrate",

@@ -36,7 +36,6 @@ import numpy as np
 
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.runner import ExperimentRun, Job, worker_cache
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     median_timings,
@@ -58,6 +57,7 @@ from vc_gym.experiments.views import (
     spots_array,
     view_poses,
 )
+from vc_gym.jobs.runner import ExperimentRun, Job, worker_cache
 from vc_gym.validation import positive_float
 
 __all__ = [
@@ -193,7 +193,7 @@ def view_job(
     timing also holds ``"learn"``: milliseconds to learn one frame into a map of the
     atlas' config.
     """
-    from vc_gym.envs.aibo_room import AiboRoomEnv
+    from vc_gym.sim.aibo_room import AiboRoomEnv
 
     room = dict(room or {})
     env = worker_cache(
@@ -457,10 +457,10 @@ def run_environments(
     """The orientation experiment in every registered scene (paper 5.3: other places).
 
     Same parameters as :func:`run_orientation`; ``scenes`` defaults to every scene
-    registered in this process (:func:`vc_gym.envs.scenes.scene_names`; a scene a user
+    registered in this process (:func:`vc_gym.sim.scenes.scene_names`; a scene a user
     registered must also be registered in the workers, see that package).
     """
-    from vc_gym.envs.scenes import scene_names
+    from vc_gym.sim.scenes import scene_names
 
     return _run_views(
         "environments", out_dir, opts, trackers, scenes or list(scene_names()), modes, light
@@ -527,7 +527,7 @@ def _run_views(name, out_dir, opts, trackers, scenes, modes=None, light=1.0) -> 
 
 def _plot_scenes(path: Path, per_scene: Mapping[str, Any], tracker: str = "grid") -> None:
     """Mean |heading error| vs distance, one line per scene (for one tracker)."""
-    from vc_gym.experiments.output import new_figure, save_figure
+    from vc_gym.jobs.output import new_figure, save_figure
 
     fig = new_figure(figsize=(6.5, 4), layout="constrained")
     ax = fig.subplots()
@@ -551,7 +551,7 @@ def _plot_scenes(path: Path, per_scene: Mapping[str, Any], tracker: str = "grid"
 
 
 def check_scenes(scenes: Sequence[str]) -> list[str]:
-    from vc_gym.envs.scenes import check_scene_name
+    from vc_gym.sim.scenes import check_scene_name
 
     out = [check_scene_name(s) for s in scenes]
     if len(set(out)) != len(out):

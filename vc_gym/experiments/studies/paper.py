@@ -17,10 +17,10 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from vc_gym.experiments.runner import check_out_dir, package_versions
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.homing import PAPER_MEAN_CM, PAPER_STD_CM
 from vc_gym.experiments.views import COMPASS
+from vc_gym.jobs.runner import check_out_dir, package_versions
 from vc_gym.persistence import write_atomic
 
 __all__ = ["run_paper", "summary_lines", "write_report"]
@@ -55,8 +55,8 @@ def run_paper(out_dir: str | os.PathLike, opts: ExperimentOptions | None = None)
     """
     import time
 
-    from vc_gym.envs.scenes import scene_names
     from vc_gym.experiments.studies import get_experiment
+    from vc_gym.sim.scenes import scene_names
 
     opts = opts or ExperimentOptions()
     size = "quick" if opts.size == "quick" else "paper"
@@ -89,7 +89,7 @@ def run_paper(out_dir: str | os.PathLike, opts: ExperimentOptions | None = None)
         durations[name] = round(time.perf_counter() - t, 1)
     compared = compare(results)
     doc = {"experiment": "paper", "settings": {"seed": opts.seed, "size": size}, **compared}
-    from vc_gym.experiments.output import write_json
+    from vc_gym.jobs.output import write_json
 
     write_json(out / "results.json", doc)
     runs = {n: json.loads((out / n / "run.json").read_text()) for n in results}

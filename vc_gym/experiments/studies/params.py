@@ -22,7 +22,6 @@ import numpy as np
 
 from vc_gym.compass import CompassConfig
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     median_timings,
@@ -38,6 +37,7 @@ from vc_gym.experiments.studies.orientation import (
     views_summary,
 )
 from vc_gym.experiments.views import COMPASS
+from vc_gym.jobs.output import new_figure, save_figure
 
 __all__ = ["PARAMETERS", "run_params", "summary_lines"]
 

@@ -29,12 +29,8 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from vc_gym.angles import wrap180
-from vc_gym.baselines import NoisyMagneticCompass, make_sensor
-from vc_gym.envs.scenes import scene_names
-from vc_gym.experiments.output import new_figure, save_figure
 from vc_gym.experiments.real_data import ROTATION_SETS, default_real_data_dir, load_rotation_set
 from vc_gym.experiments.real_rotation import rotation_set_errors
-from vc_gym.experiments.runner import ExperimentRun, Job
 from vc_gym.experiments.spot_sensors import fit_colours, room, teach
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
@@ -46,6 +42,10 @@ from vc_gym.experiments.studies.common import (
 from vc_gym.experiments.studies.homing import run_homing
 from vc_gym.experiments.studies.orientation import check_scenes, rear_half_centre
 from vc_gym.experiments.views import learning_turn, look
+from vc_gym.heading_sensors import NoisyMagneticCompass, make_sensor
+from vc_gym.jobs.output import new_figure, save_figure
+from vc_gym.jobs.runner import ExperimentRun, Job
+from vc_gym.sim.scenes import scene_names
 
 __all__ = [
     "DISTANCES_M",
@@ -57,7 +57,7 @@ __all__ = [
 ]
 
 #: Sensors compared, by the name the results use: a sensor spec
-#: (:func:`vc_gym.baselines.make_sensor`).
+#: (:func:`vc_gym.heading_sensors.make_sensor`).
 SENSORS: dict[str, Any] = {
     "visual_compass": "visual_compass",
     "visual_compass_improved": {"type": "visual_compass", "exposure": "mean"},

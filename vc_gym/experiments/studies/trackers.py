@@ -19,8 +19,6 @@ from typing import Any
 import numpy as np
 
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.output import new_figure, save_figure
-from vc_gym.experiments.runner import ExperimentRun, Job
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     median_timings,
@@ -34,6 +32,8 @@ from vc_gym.experiments.studies.orientation import (
     orientation_stage,
 )
 from vc_gym.experiments.views import COMPASS
+from vc_gym.jobs.output import new_figure, save_figure
+from vc_gym.jobs.runner import ExperimentRun, Job
 
 __all__ = ["run_trackers", "summary_lines"]
 
@@ -96,7 +96,7 @@ def run_trackers(
         Per tracker: homing figures (pooled, and mean ± std over seeds) and heading
         errors on the grid, and the leaderboard order.
     """
-    from vc_gym.envs.scenes import check_scene_name, scene_names
+    from vc_gym.sim.scenes import check_scene_name, scene_names
 
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)

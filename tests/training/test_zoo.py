@@ -1,0 +1,68 @@
+"""RL Baselines3 Zoo trains vc_gym/Homing-v0 with the hyperparameters we ship."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from vc_gym.hyperparams import zoo_hyperparams
+from vc_gym.training.train import TrainConfig
+
+
+def _policy_kwargs(text: str) -> dict:
+    call = ast.parse(text, mode="eval").body
+    assert isinstance(call, ast.Call) and call.func.id == "dict"
+    return {k.arg: ast.literal_eval(k.value) for k in call.keywords}
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_shipped_hyperparameters_are_vc_gym_train_defaults(algo):
+    hp = zoo_hyperparams(algo)["vc_gym/Homing-v0"]
+    d = TrainConfig(algo=algo)
+    assert hp["n_envs"] == d.n_envs and hp["n_timesteps"] == d.timesteps
+    assert hp["batch_size"] == d.batch_size and hp["learning_rate"] == d.learning_rate
+    assert hp["gamma"] == d.gamma
+    if algo == "ppo":
+        assert hp["n_steps"] == d.n_steps
+    pk = _policy_kwargs(hp["policy_kwargs"])
+    assert pk == {"net_arch": list(d.net_arch), "log_std_init": d.log_std_init}
+    env = hp["env_kwargs"]
+    assert env["stop_time_s"] == d.stop_time_s and env["learn_time_s"] == d.learn_time_s
+    assert env["confirm_stop_m"] == d.confirm_stop_m
+    assert env.get("closeness_bonus", 0.0) == d.closeness_bonus
+    assert env.get("min_walk_m", 0.0) == d.min_walk_m
+    assert env.get("previous_action", False) == d.previous_action
+    assert env["scene"] == d.scene and env["atlas_file"].endswith(".npz")
+    with pytest.raises(ValueError, match="ppo and sac"):
+        zoo_hyperparams("dqn")
+
+
+def test_a_tiny_zoo_training_run(tmp_path):
+    pytest.importorskip("rl_zoo3")
+    from stable_baselines3 import PPO
+
+    cmd = [
+        sys.executable, "-m", "rl_zoo3.train",
+        "--algo", "ppo", "--env", "vc_gym/Homing-v0", "--gym-packages", "vc_gym",
+        "-conf", "vc_gym.hyperparams.ppo",
+        "-n", "64", "--hyperparams", "n_steps:32", "batch_size:32",
+        "--env-kwargs", "learn_time_s:0.2", "max_homing_s:3.0", "stop_time_s:0.1",
+        "learning_seed:0", "atlas_file:'place.npz'",
+        "-f", "logs", "--eval-freq", "-1", "--seed", "0",
+    ]  # fmt: skip
+    done = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    run = tmp_path / "logs" / "ppo" / "vc_gym-Homing-v0_1"
+    assert (tmp_path / "place.npz").is_file()  # learned once, by the first env
+    assert (run / "0.monitor.csv").is_file() and (run / "1.monitor.csv").is_file()
+    model = PPO.load(run / "vc_gym-Homing-v0.zip", device="cpu")
+    again = PPO.load(run / "vc_gym-Homing-v0.zip", device="cpu")
+    obs = np.random.default_rng(0).uniform(-2, 2, (10, *model.observation_space.shape))
+    a = model.predict(obs.astype(np.float32), deterministic=True)[0]
+    b = again.predict(obs.astype(np.float32), deterministic=True)[0]
+    np.testing.assert_array_equal(a, b)
+    assert a.shape == (10, 3)
