@@ -12,6 +12,7 @@ The world itself (robot, scenes, camera, ``vc_gym/AiboRoom-v0``) is :mod:`vc_gym
 import warnings
 from typing import Any
 
+import vc_gym.sim
 from vc_gym.envs.homing import HomingFeatures, PreviousAction, StopAction, make_homing_env
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.learning import (
@@ -28,28 +29,11 @@ from vc_gym.envs.learning import (
 from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.wrappers import CompassObservation
 
-#: Names that moved to :mod:`vc_gym.sim`; importing them from here still works, with a
-#: DeprecationWarning, for one release.
-_MOVED_TO_SIM = {
-    "LOCOMOTION_MODES",
-    "SCENES",
-    "AiboRoomEnv",
-    "HeadCameraSpec",
-    "OdometryNoise",
-    "Quadruped",
-    "Scene",
-    "build_scene",
-    "register_scene",
-    "render_camera",
-    "scene_names",
-    "unregister_scene",
-}
-
 
 def __getattr__(name: str) -> Any:
-    if name in _MOVED_TO_SIM:
-        import vc_gym.sim
-
+    # every public name of vc_gym.sim lived here before it moved: still served, for one
+    # release, with a DeprecationWarning
+    if name in vc_gym.sim.__all__:
         warnings.warn(
             f"vc_gym.envs.{name} moved to vc_gym.sim.{name}", DeprecationWarning, stacklevel=2
         )
