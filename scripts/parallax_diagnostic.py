@@ -45,7 +45,7 @@ from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.compass.parallax import ParallaxMap, learn_depths
 from vc_gym.experiments.atlases import atlas_spec, learn_atlas_job
 from vc_gym.experiments.studies.common import scene_field_bounds
-from vc_gym.experiments.studies.orientation import GRID_AROUND_M, training_spots
+from vc_gym.experiments.studies.orientation_grid import GRID_AROUND_M, training_spots
 from vc_gym.experiments.views import field_grid, learning_turn, look, view_poses
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.worlds.room import make_room, render_room_view

@@ -7,7 +7,8 @@ import pytest
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
 from vc_gym.experiments.real_data import default_real_data_dir
-from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
+from vc_gym.worlds.panorama import Panorama, render_view
+from vc_gym.worlds.panorama_painters import make_panorama
 from vc_gym.worlds.room import Room, make_room, render_room_view
 
 #: Yaws of the learning frames: 8 body directions x 3 head pans (paper 4.3).

@@ -61,7 +61,18 @@ def test_bench_compass_json_last_line(capsys):
 
 def test_experiment_without_data_fails_clearly(tmp_path, capsys):
     assert main(["experiment", "real-rotation", "--data", str(tmp_path / "nope")]) == 2
-    assert "not found" in capsys.readouterr().err
+    assert "--data" in capsys.readouterr().err
+
+
+def test_real_rotation_without_any_photo_folder_says_where_to_put_them(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.setattr("vc_gym.experiments.real_rotation.default_real_data_dir", lambda: None)
+    out = tmp_path / "out"
+    assert main(["experiment", "real-rotation", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "real photos not found" in err and "VC_GYM_REAL_DATA" in err
+    assert not out.exists()
 
 
 def test_demo_runs_the_main_job(tmp_path, capsys):
@@ -206,7 +217,7 @@ def test_real_rotation_without_photos_leaves_no_folder(tmp_path, capsys):
     out = tmp_path / "out"
     argv = ["experiment", "real-rotation", "--data", str(tmp_path / "nope"), "--out", str(out)]
     assert main(argv) == 2
-    assert "not found" in capsys.readouterr().err
+    assert "not a folder" in capsys.readouterr().err
     assert not out.exists()
 
 
@@ -218,20 +229,20 @@ def _interrupted(*args, **kwargs):
 @pytest.mark.parametrize(
     ("command", "argv", "hint"),
     [
-        ("_cmd_check", ["check"], ""),
-        ("_cmd_demo", ["demo"], ""),
+        ("check.run", ["check"], ""),
+        ("demo.run", ["demo"], ""),
         (
-            "_cmd_experiment",
+            "experiment.run_experiment",
             ["experiment", "homing", "--out", "RUN"],
             "; rerun the same command to resume from the jobs saved in RUN",
         ),
         (
-            "_cmd_experiment",
+            "experiment.run_experiment",
             ["evaluate", "--out", "RUN"],
             "; rerun the same command to resume from the jobs saved in RUN",
         ),
         (
-            "_cmd_experiment",
+            "experiment.run_experiment",
             ["experiment", "homing"],
             "; rerun the same command to resume from the jobs saved in vc_gym_homing",
         ),
@@ -245,7 +256,7 @@ def test_ctrl_c_is_one_line_and_status_130(monkeypatch, capsys, command, argv, h
 
 
 def test_ctrl_c_in_train_says_how_to_resume(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr("vc_gym.cli._cmd_train", _interrupted)
+    monkeypatch.setattr("vc_gym.cli.train.run", _interrupted)
     run = tmp_path / "agent"
     assert main(["train", "--out", str(run)]) == 130
     assert "no checkpoint was saved" in capsys.readouterr().err

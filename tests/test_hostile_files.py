@@ -26,7 +26,8 @@ from vc_gym.compass import Camera, CompassAtlas, VisualCompass
 from vc_gym.config_files import read_settings
 from vc_gym.errors import MapFileError
 from vc_gym.persistence import load_npz_checked, save_npz_atomic
-from vc_gym.worlds.panorama import make_panorama, render_view
+from vc_gym.worlds.panorama import render_view
+from vc_gym.worlds.panorama_painters import make_panorama
 
 #: Every example must finish within this (a hang or a memory blow-up is a failure).
 DEADLINE = timedelta(seconds=20)
@@ -221,7 +222,7 @@ settings_text = st.text(
 @FUZZ
 @given(text=settings_text)
 def test_a_settings_file_of_any_text_reads_or_is_refused(tmp_path, suffix, text):
-    from vc_gym.training.train import read_train_config
+    from vc_gym.training.config import read_train_config
 
     path = tmp_path / f"t{suffix}"
     path.write_text(text)
@@ -238,7 +239,7 @@ def test_a_settings_file_of_any_text_reads_or_is_refused(tmp_path, suffix, text)
 @FUZZ
 @given(data=st.data())
 def test_a_training_settings_file_with_any_values_is_read_or_refused(tmp_path, data):
-    from vc_gym.training.train import TrainConfig, read_train_config
+    from vc_gym.training.config import TrainConfig, read_train_config
 
     names = sorted(TrainConfig.__dataclass_fields__)
     values = {

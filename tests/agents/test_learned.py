@@ -9,6 +9,7 @@ import pytest
 
 from vc_gym.agents.learned import LearnedHomingAgent
 from vc_gym.cli import main
+from vc_gym.experiments.episode import check_agent_env
 
 
 def test_bad_model_files_are_clear_errors(tmp_path, capsys):
@@ -73,7 +74,7 @@ def test_env_arguments_the_env_refuses_name_the_config_file(tmp_path, capsys, ch
     cfg.write_text(json.dumps(data))
     agent = LearnedHomingAgent(tmp_path / "agent" / "model.zip")
     with pytest.raises(ValueError, match=f"{cfg}: its env arguments .*{match}"):
-        agent.check_env()
+        check_agent_env(agent, str(agent.config_path))
     # the command refuses it before any work, and leaves no output folder behind
     out = tmp_path / "run"
     argv = ["evaluate", "--agent", str(tmp_path / "agent" / "model.zip"), "--out", str(out)]
@@ -87,7 +88,7 @@ def test_shipped_policy_was_trained_with_the_default_settings():
     from dataclasses import replace
 
     from vc_gym.agents.learned import PRETRAINED_MODEL
-    from vc_gym.training.train import TrainConfig, read_train_config
+    from vc_gym.training.config import TrainConfig, read_train_config
 
     shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
     # the run measured its goal (centred); everything it was given is the defaults

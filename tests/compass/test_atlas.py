@@ -13,7 +13,7 @@ from vc_gym.compass import (
     CompassConfig,
     NotLearnedError,
     VisualCompass,
-    visual_compass,
+    likelihood,
 )
 from vc_gym.worlds.room import render_room_view
 
@@ -173,7 +173,7 @@ def test_scores_do_not_depend_on_how_many_rows_are_gathered_at_once(
     # one group per gather, a few groups, and every row at once give the same sums
     image = render_room_view(room, 0.3, 0.6, Camera(yaw_deg=75.0))
     raw, full = atlas.scores(image, Camera())
-    monkeypatch.setattr(visual_compass, "_GATHER_BYTES", gather_bytes)
+    monkeypatch.setattr(likelihood, "_GATHER_BYTES", gather_bytes)
     raw2, full2 = atlas.scores(image, Camera())
     np.testing.assert_array_equal(raw2, raw)
     for a, b in zip(full, full2, strict=True):

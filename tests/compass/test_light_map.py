@@ -167,3 +167,15 @@ def test_an_atlas_of_map_exposure_compasses_keeps_their_light(tmp_path, room_pan
     np.testing.assert_array_equal(loaded.compasses[0]._light.columns, map_compass._light.columns)
     img = render_view(room_pano, Camera(yaw_deg=300.0), illumination=0.5)
     assert loaded.scores(img, Camera())[0][0] == atlas.scores(img, Camera())[0][0]
+
+
+def test_a_light_map_is_resampled_and_regrouped_like_the_counts():
+    light = LightMap(4)
+    light.add(np.array([0, 1, 1, 3]), np.array([0.2, 0.4, 0.6, 0.8]))
+    copied = light.resampled(np.array([3, 3, 0, 1]))
+    np.testing.assert_array_equal(copied.level_sum, [0.8, 0.8, 0.2, 1.0])
+    np.testing.assert_array_equal(copied.columns, [1, 1, 1, 2])
+    moved = light.regrouped(np.array([2, 2, 0, 0]))
+    np.testing.assert_allclose(moved.level_sum, [0.8, 0.0, 1.2, 0.0])
+    np.testing.assert_array_equal(moved.columns, [1, 0, 3, 0])
+    np.testing.assert_array_equal(light.columns, [1, 2, 0, 1])  # the original is unchanged

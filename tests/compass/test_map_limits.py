@@ -15,11 +15,17 @@ import zipfile
 import numpy as np
 import pytest
 
-from vc_gym.compass import AIBO_HFOV_DEG, Camera, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.compass import visual_compass as visual_compass_module
+from vc_gym.compass import (
+    AIBO_HFOV_DEG,
+    Camera,
+    CompassAtlas,
+    CompassConfig,
+    VisualCompass,
+    map_files,
+)
 from vc_gym.compass.atlas import MAX_ATLAS_BYTES, MAX_SPOTS
 from vc_gym.compass.config import MAX_MAP_BYTES, MAX_MAP_ENTRIES
-from vc_gym.compass.visual_compass import MAX_LEARNED_SIZES
+from vc_gym.compass.map_files import MAX_LEARNED_SIZES
 from vc_gym.errors import MapFileError
 from vc_gym.persistence import MAX_MEMBERS, load_npz_checked
 from vc_gym.worlds.panorama import render_view
@@ -191,7 +197,7 @@ def test_a_map_file_with_implausible_entries_is_refused(small_map, tmp_path, key
 
 
 def test_a_map_learns_a_bounded_number_of_frame_sizes(room_pano, monkeypatch):
-    monkeypatch.setattr(visual_compass_module, "MAX_LEARNED_SIZES", 2)
+    monkeypatch.setattr(map_files, "MAX_LEARNED_SIZES", 2)
     vc = _learned(room_pano, CompassConfig(n_colors=3), yaws=[0.0])
     vc.learn(render_view(room_pano, Camera(), width=200, height=150), Camera())
     with pytest.raises(ValueError, match="at most 2 different sizes"):

@@ -93,7 +93,7 @@ def test_learned_parallax_map_fits_off_the_spot(room, turns, pos):
     for _, m in around:
         merged.merge(m)
     warped = ParallaxMap.learn((0.0, 0.0), spot, around).at(pos)
-    # the improved mode's map (the turns merged as taken) against the learned warp
+    # the spot-grid mode's map (the turns merged as taken) against the learned warp
     assert _mean_error(room, warped, pos, 2) < min(2.0, _mean_error(room, merged, pos, 2) / 3)
 
 

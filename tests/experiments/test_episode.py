@@ -11,23 +11,23 @@ from vc_gym.experiments.demo import run_demo
 from vc_gym.experiments.episode import EpisodeRecord, make_homing_run, run_episode
 from vc_gym.experiments.studies import ExperimentOptions
 from vc_gym.experiments.studies.homing import run_homing
-from vc_gym.jobs.runner import LocalBackend
+from vc_gym.jobs.backends import LocalBackend
 
 SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
 
 
 def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
-    demo = run_demo(tmp_path, seed=2, progress=False, mode="improved", **SHORT)
+    demo = run_demo(tmp_path, seed=2, progress=False, mode="check-home", **SHORT)
     # the experiment learns the place in a job, saves the atlas and homes with the
     # loaded atlas: the same episode, so the atlas file is an exact round trip
     opts = ExperimentOptions(seed=2, backend=LocalBackend(1), progress=False)
     evaluation = run_homing(
-        tmp_path / "homing", opts, episodes=1, field=False, mode="improved", **SHORT
+        tmp_path / "homing", opts, episodes=1, field=False, mode="check-home", **SHORT
     )
     episode = evaluation["per_episode"][0]
     assert episode["seed"] == 3 and demo["learning_seed"] == 2
     assert {k: demo[k] for k in episode} == episode
-    assert demo["mode"] == evaluation["settings"]["mode"] == "improved"
+    assert demo["mode"] == evaluation["settings"]["mode"] == "check-home"
     assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
 
 
@@ -58,12 +58,14 @@ def test_modes_choose_the_learning_and_the_policy():
     from vc_gym.experiments.episode import HOMING_MODES, homing_mode
 
     assert homing_mode("paper").policy == {} and homing_mode("paper").learning == {}
-    assert homing_mode("improved").policy == {"verify_home": True}
-    assert homing_mode("improved").learning == {"normalise_at": "start"}
-    assert set(HOMING_MODES) == {"paper", "improved"}
+    assert homing_mode("check-home").policy == {"verify_home": True}
+    assert homing_mode("check-home").learning == {"normalise_at": "start"}
+    assert set(HOMING_MODES) == {"paper", "check-home"}
+    with pytest.warns(DeprecationWarning, match="check-home"):
+        assert homing_mode("improved") is HOMING_MODES["check-home"]
     with pytest.raises(ValueError, match="paper"):
         homing_mode("best")
-    run = make_homing_run(mode="improved", policy={"max_verifications": 2}, **SHORT)
+    run = make_homing_run(mode="check-home", policy={"max_verifications": 2}, **SHORT)
     try:
         policy = run.act.__self__
         assert policy.verify_home and policy.max_verifications == 2

@@ -51,8 +51,10 @@ def test_every_experiment_wrote_its_files(paper_quick, name):
 
 def test_every_experiment_is_tested_end_to_end():
     # the paper report runs ORDER; the others have end-to-end tests of their own (agents:
-    # tests/training/test_training.py, it needs a trained model)
-    assert set(EXPERIMENTS) == {*ORDER, "paper", "localization", "agents"}
+    # tests/training/test_training.py, it needs a trained model; real-rotation and
+    # synthetic-compass: tests/test_cli.py)
+    expected = {*ORDER, "paper", "localization", "agents", "real-rotation", "synthetic-compass"}
+    assert set(EXPERIMENTS) == expected
 
 
 def test_the_report_sets_our_figures_beside_the_papers(paper_quick):
@@ -97,7 +99,7 @@ def test_sensors_compares_every_sensor_on_the_same_views(paper_quick):
             assert at_spot["median_abs_error_deg"] <= at_spot["p90_abs_error_deg"]
         assert {k.split("m_")[0] for k in per["all_scenes"]} <= {f"{d:g}" for d in DISTANCES_M}
     # at the spot in full light every image sensor knows its heading
-    for name in ("visual_compass_improved", "image_difference", "feature", "sector_colour"):
+    for name in ("visual_compass_mean_exposure", "image_difference", "feature", "sector_colour"):
         assert sim[name]["all_scenes"]["0m_light1"]["median_abs_error_deg"] < 5.0, name
     if default_real_data_dir() is not None:
         assert set(r["real"]) == {"rotation_grail", "rotation_parrington"}
@@ -226,22 +228,17 @@ def test_a_dead_worker_fails_its_jobs_clearly_not_the_run(homing_quick, tmp_path
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["experiment", "params", "--agent", "scripted"], "does not take --agent"),
-        (["experiment", "homing", "--tracker", "grid", "--tracker", "kalman"], "one --tracker"),
         (["experiment", "orientation", "--tracker", "kalmann"], "unknown tracker"),
         (["experiment", "trackers", "--scenes", "nowhere"], "nowhere"),
         (["experiment", "homing", "--backend", "local", "--address", "auto"], "address"),
         (["experiment", "homing", "--atlas", "/no/such/folder"], "not a folder"),
         (["experiment", "homing", "--seeds", "1,1"], "distinct"),
-        (["experiment", "homing", "--modes", "improved"], "does not take --modes"),
         (["experiment", "orientation", "--modes", "paper,better"], "unknown mode"),
         (["experiment", "orientation", "--modes", "paper,paper"], "distinct"),
         (["experiment", "orientation", "--light", "1.5"], "light must be in"),
         (["experiment", "environments", "--light", "0"], "light"),
-        (["experiment", "homing", "--light", "0.5"], "does not take --light"),
         (["experiment", "homing", "--sensor", "compass"], "choose one of"),
         (["experiment", "homing", "--sensor", "feature", "--tracker", "kalman"], "grid tracker"),
-        (["experiment", "orientation", "--sensor", "feature"], "does not take --sensor"),
     ],
 )
 def test_bad_arguments_fail_before_any_work(tmp_path, capsys, argv, message):
@@ -249,6 +246,28 @@ def test_bad_arguments_fail_before_any_work(tmp_path, capsys, argv, message):
     assert main([*argv, "--out", str(out), "--quick"]) == 2
     assert message in capsys.readouterr().err
     assert not (out / "jobs").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["experiment", "params", "--agent", "scripted"],
+        ["experiment", "homing", "--modes", "improved"],
+        ["experiment", "homing", "--light", "0.5"],
+        ["experiment", "orientation", "--sensor", "feature"],
+    ],
+)
+def test_a_flag_the_experiment_does_not_declare_is_refused_with_its_own_usage(
+    tmp_path, capsys, argv
+):
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as e:
+        main([*argv, "--out", str(out), "--quick"])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert f"usage: vc-gym experiment {argv[1]} " in err
+    assert f"unrecognized arguments: {argv[2]}" in err
+    assert not out.exists()
 
 
 @pytest.mark.parametrize(
@@ -294,10 +313,10 @@ def test_bench_backends_measures_every_backend_on_the_same_jobs():
 def test_orientation_in_both_modes(tmp_path, capsys):
     out = tmp_path / "orient"
     argv = ["experiment", "orientation", "--out", str(out), *QUICK, "--tracker", "grid"]
-    assert main([*argv, "--modes", "paper,improved"]) == 0
+    assert main([*argv, "--modes", "paper,spot-grid"]) == 0
     r = json.loads((out / "results.json").read_text())
-    assert set(r["modes"]) == {"paper", "improved"} and "scenes" not in r
-    paper, improved = (r["modes"][m]["scenes"]["robolab"] for m in ("paper", "improved"))
+    assert set(r["modes"]) == {"paper", "spot-grid"} and "scenes" not in r
+    paper, improved = (r["modes"][m]["scenes"]["robolab"] for m in ("paper", "spot-grid"))
     assert paper["training_spot"] == [-1.5, 0.0]
     # the quick size's spots are 2 m apart (6 in robolab; the other sizes' 1 m, 24)
     assert len(improved["spots"]) == 6 and improved["spots"][0] == [-2.0, -1.0]
@@ -305,14 +324,14 @@ def test_orientation_in_both_modes(tmp_path, capsys):
     for row in improved["trackers"]["grid"]["by_distance"]:
         assert row["bin_end_m"] <= 1.5
     assert {"grid", "compass"} <= set(improved["trackers"])
-    assert (out / "arrow_field_improved.png").is_file()
-    assert (out / "error_vs_distance_improved.png").is_file()
+    assert (out / "arrow_field_spot-grid.png").is_file()
+    assert (out / "error_vs_distance_spot-grid.png").is_file()
     text = capsys.readouterr().out
-    assert "improved mode:" in text and "6 spots" in text
+    assert "spot-grid mode:" in text and "6 spots" in text
 
 
-def test_the_improved_mode_gives_the_built_in_trackers_a_shortlist():
-    from vc_gym.experiments.studies.orientation import (
+def test_the_spot_grid_mode_gives_the_built_in_trackers_a_shortlist():
+    from vc_gym.experiments.studies.orientation_grid import (
         MODE_TRACKER_OPTIONS,
         mode_trackers,
         training_spots,
@@ -325,10 +344,17 @@ def test_the_improved_mode_gives_the_built_in_trackers_a_shortlist():
         "user": "my_package.trackers:make",
     }
     assert mode_trackers(trackers, "paper") == trackers
-    assert len(training_spots((-3.0, 3.0, -2.0, 2.0), "improved")) == 24  # robolab's field
-    improved = mode_trackers(trackers, "improved")
-    options = MODE_TRACKER_OPTIONS["improved"]
+    assert len(training_spots((-3.0, 3.0, -2.0, 2.0), "spot-grid")) == 24  # robolab's field
+    improved = mode_trackers(trackers, "spot-grid")
+    options = MODE_TRACKER_OPTIONS["spot-grid"]
     assert improved["grid"] == {"type": "grid", **options}
     assert improved["k"] == {"type": "kalman", "gate_sigma": 2.0, **options}
     assert improved["mine"]["shortlist"] == 5  # set explicitly: kept
     assert improved["user"] == "my_package.trackers:make"
+
+
+def test_the_old_view_mode_name_warns_and_means_spot_grid():
+    from vc_gym.experiments.studies.orientation import _check_modes
+
+    with pytest.warns(DeprecationWarning, match="spot-grid"):
+        assert _check_modes(["paper", "improved"]) == ["paper", "spot-grid"]

@@ -12,13 +12,10 @@ from pathlib import Path
 
 import pytest
 
-from vc_gym.jobs.runner import (
-    ExperimentRun,
-    Job,
-    LocalBackend,
-    check_out_dir,
-    make_backend,
-)
+from vc_gym.jobs.backends import LocalBackend, make_backend
+from vc_gym.jobs.job import Job
+from vc_gym.jobs.output import check_out_dir
+from vc_gym.jobs.run import ExperimentRun
 
 HERE = Path(__file__).parent
 JOBS = "runner_jobs"
@@ -242,3 +239,26 @@ def test_bad_outputs_and_arguments_are_clear_errors(tmp_path):
     run = ExperimentRun(tmp_path / "r", "toy", LocalBackend(1), {}, progress=False)
     with pytest.raises(ValueError, match="not unique"):
         run.run("s", [Job("a", f"{JOBS}:square", {"x": 1})] * 2)
+
+
+# --- the deprecated import place vc_gym.jobs.runner ---------------------------------------
+
+
+def test_names_read_from_the_old_runner_module_warn_and_are_the_same_objects():
+    from vc_gym.jobs import runner
+
+    assert {"Job", "ExperimentRun", "LocalBackend", "make_backend", "check_workers"} <= set(
+        runner.MOVED
+    )
+    for name, module in runner.MOVED.items():
+        moved = rf"jobs\.runner\.{name} moved to {module.__name__}\.{name}"
+        with pytest.warns(DeprecationWarning, match=moved):
+            assert getattr(runner, name) is getattr(module, name)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        runner.no_such_name  # noqa: B018
+
+
+def test_from_import_of_the_old_runner_module_warns():
+    with pytest.warns(DeprecationWarning, match="vc_gym.jobs.backends.make_backend"):
+        from vc_gym.jobs.runner import make_backend as old
+    assert old is make_backend

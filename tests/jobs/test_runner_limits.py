@@ -13,23 +13,18 @@ from pathlib import Path
 
 import pytest
 
-from vc_gym.jobs import runner
-from vc_gym.jobs.runner import (
-    MAX_WORKERS,
-    ExperimentRun,
-    LocalBackend,
-    RayBackend,
-    check_workers,
-    make_backend,
-    max_workers,
-)
+from vc_gym.jobs import job as job_files
+from vc_gym.jobs.backends import LocalBackend, RayBackend, make_backend
+from vc_gym.jobs.job import Job
+from vc_gym.jobs.run import ExperimentRun
+from vc_gym.jobs.workers import MAX_WORKERS, MAX_WORKERS_PER_CPU, check_workers, max_workers
 
 JOBS = "runner_jobs"
 
 
 def square_jobs(n, log=None, sleep_s=0.0):
     return [
-        runner.Job(f"x{i:02d}", f"{JOBS}:square", {"x": i, "log": log, "sleep_s": sleep_s})
+        Job(f"x{i:02d}", f"{JOBS}:square", {"x": i, "log": log, "sleep_s": sleep_s})
         for i in range(n)
     ]
 
@@ -39,7 +34,7 @@ def _runs(log: Path) -> int:
 
 
 def test_max_workers_follows_the_cpus_within_the_hard_bound():
-    assert max_workers() == min(MAX_WORKERS, runner.MAX_WORKERS_PER_CPU * (os.cpu_count() or 1))
+    assert max_workers() == min(MAX_WORKERS, MAX_WORKERS_PER_CPU * (os.cpu_count() or 1))
     assert check_workers(max_workers()) == max_workers()
 
 
@@ -106,7 +101,7 @@ def test_an_oversized_job_file_is_not_trusted_and_its_job_runs_again(tmp_path, m
             "squares", square_jobs(2, str(log))
         )
     assert _runs(log) == 2
-    monkeypatch.setattr(runner, "MAX_JOB_FILE_BYTES", 2_000)
+    monkeypatch.setattr(job_files, "MAX_JOB_FILE_BYTES", 2_000)
     path = out / "jobs" / "squares" / "x01.json"
     rec = json.loads(path.read_text())
     rec["padding"] = "x" * 5_000  # valid JSON, same job, too large to be read

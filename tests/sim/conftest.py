@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import tempfile
+
 import pybullet
 import pytest
 from pybullet_utils import bullet_client
@@ -15,3 +17,10 @@ def bc():
         yield client
     finally:
         client.disconnect()
+
+
+@pytest.fixture
+def private_tmp(tmp_path, monkeypatch):
+    """Make ``tempfile`` write into an empty folder of this test only."""
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    return tmp_path

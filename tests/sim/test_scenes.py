@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 
 import gymnasium as gym
 import numpy as np
@@ -12,7 +11,6 @@ import pybullet
 import pytest
 from pybullet_utils import bullet_client
 
-from vc_gym.sim import textures
 from vc_gym.sim.scenes import SCENES, Scene, build_scene, scene_names
 
 W, H, HFOV = 208, 160, 56.9
@@ -132,13 +130,6 @@ def test_round_poses_render_without_holes(bc):
                 assert np.mean(img.max(axis=2) == 0) < 0.01, (name, eye, yaw)
 
 
-@pytest.fixture
-def private_tmp(tmp_path, monkeypatch):
-    """Make ``tempfile`` write into an empty folder of this test only."""
-    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    return tmp_path
-
-
 def test_rebuild_after_reset_simulation(bc, private_tmp):
     first = None
     for _ in range(3):
@@ -174,50 +165,6 @@ def test_bad_arguments(bc):
     with pytest.raises(ValueError, match="bool"):
         build_scene(bc, "office", np.random.default_rng(0), randomize="yes")  # type: ignore[arg-type]
     assert bc.getNumBodies() == 0
-
-
-# ------------------------------------------------------------------------- textures
-
-
-def test_procedural_posters_are_coarse_seeded_rgb():
-    for style in textures.POSTER_STYLES:
-        a = textures.procedural_poster(np.random.default_rng(3), (90, 60), style)
-        b = textures.procedural_poster(np.random.default_rng(3), (90, 60), style)
-        assert a.shape == (90, 60, 3) and a.dtype == np.uint8
-        np.testing.assert_array_equal(a, b)
-        assert a.std() > 5.0
-    with pytest.raises(ValueError, match="blocks"):
-        textures.procedural_poster(np.random.default_rng(0), 64, "plaid")
-    with pytest.raises(ValueError, match="16"):
-        textures.procedural_poster(np.random.default_rng(0), 8)
-    photos = textures.photo_posters()
-    assert photos and all(p.ndim == 3 and p.shape[2] == 3 for p in photos)
-
-
-def test_canvas_is_measured_in_metres_with_y_up():
-    c = textures.Canvas(2.0, 1.0, 10.0, (0, 0, 0))
-    c.rect(0.0, 0.5, 0.0, 0.2, (255, 0, 0))  # bottom-left corner
-    img = c.image()
-    assert img.shape == (10, 20, 3)
-    assert tuple(img[-1, 0]) == (255, 0, 0) and tuple(img[0, 0]) == (0, 0, 0)
-    assert tuple(img[-2, 4]) == (255, 0, 0) and tuple(img[-3, 4]) == (0, 0, 0)
-
-
-def test_texture_store_loads_each_image_once(bc, private_tmp):
-    img = textures.procedural_poster(np.random.default_rng(0), 32)
-    with textures.TextureStore(bc) as store:
-        t1 = store.load_image(img)
-        t2 = store.load_image(img.copy())
-        t3 = store.load("key", lambda: img)
-        assert t1 == t2 == t3 >= 0 and len(store) == 1
-        t4 = store.load_image(img[::-1].copy())
-        assert t4 != t1 and len(store) == 2
-        with pytest.raises(ValueError, match="uint8"):
-            store.load_image(img.astype(np.float32))
-        assert [p.name[: len(textures.TEXTURE_DIR_PREFIX)] for p in private_tmp.iterdir()] == [
-            textures.TEXTURE_DIR_PREFIX
-        ]
-    assert os.listdir(private_tmp) == []
 
 
 def test_making_and_closing_envs_keeps_no_python_memory():

@@ -6,13 +6,14 @@ import copy
 import json
 from dataclasses import replace
 
+import gymnasium as gym
 import numpy as np
 import pytest
 
 pytest.importorskip("stable_baselines3")
 
 import torch  # noqa: E402
-from test_training import TINY  # noqa: E402
+from tiny_configs import TINY  # noqa: E402
 from toy_envs import CountingEnv, counting_env  # noqa: E402
 
 from vc_gym.agents.learned import LearnedHomingAgent  # noqa: E402
@@ -22,7 +23,8 @@ from vc_gym.training.async_rollouts import (  # noqa: E402
     WorkerDiedError,
     policy_action,
 )
-from vc_gym.training.train import TrainConfig, train  # noqa: E402
+from vc_gym.training.config import TrainConfig  # noqa: E402
+from vc_gym.training.train import train  # noqa: E402
 
 N_STEPS = 12
 
@@ -187,7 +189,7 @@ def test_ppo_in_worker_processes_collects_asynchronously_by_default():
     assert TrainConfig.from_dict(saved).collector == "lockstep"
     # the shipped policy's config is one of those
     from vc_gym.agents.learned import PRETRAINED_MODEL
-    from vc_gym.training.train import read_train_config
+    from vc_gym.training.config import read_train_config
 
     shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
     assert shipped.collector == json.loads(
@@ -226,5 +228,5 @@ def test_vc_gym_train_with_the_lockstep_collector(tmp_path):
     assert isinstance(
         load_sb3_model("ppo", tmp_path / "model.zip", cls=AsyncRolloutPPO), AsyncRolloutPPO
     )
-    obs = np.zeros(agent.make_env().observation_space.shape, np.float32)
+    obs = np.zeros(gym.make(agent.env_id, **agent.env_kwargs).observation_space.shape, np.float32)
     assert agent.predict(obs).shape == (3,)

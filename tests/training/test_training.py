@@ -8,29 +8,15 @@ from dataclasses import replace
 import gymnasium as gym
 import numpy as np
 import pytest
+from tiny_configs import TINY
 
 from vc_gym.agents.learned import LearnedHomingAgent
 from vc_gym.cli import build_parser, main
 from vc_gym.experiments.studies import ExperimentOptions
 from vc_gym.experiments.studies.homing import run_homing
-from vc_gym.jobs.runner import LocalBackend
-from vc_gym.training.train import TrainConfig, train
-
-TINY = TrainConfig(
-    timesteps=64,
-    n_envs=2,
-    learn_time_s=0.2,
-    n_steps=32,
-    batch_size=32,
-    max_homing_s=3.0,
-    stop_time_s=0.3,  # the check runs over 3 steps (the default 5 s would make 50)
-    eval_freq=32,
-    eval_episodes=2,
-    save_freq=32,
-    demo_episodes=0,
-    home_offset_episodes=0,  # the goal is the tracker's home: no measurement to wait for
-    home_offset_centre=False,
-)
+from vc_gym.jobs.backends import LocalBackend
+from vc_gym.training.config import TrainConfig
+from vc_gym.training.train import train
 
 
 @pytest.fixture(scope="module")
@@ -100,27 +86,6 @@ def test_resume_continues_from_the_latest_checkpoint(trained, tmp_path, capsys):
     assert "only --timesteps" in capsys.readouterr().err
 
 
-def test_config_file_and_command_line(tmp_path):
-    from vc_gym.training.train import read_train_config
-
-    cfg = tmp_path / "ppo.yml"
-    cfg.write_text("algo: ppo\nnet_arch: [32, 32]\nlearning_rate: 0.001\nscene: office\n")
-    config = read_train_config(cfg, timesteps=500)
-    assert config.net_arch == (32, 32) and config.learning_rate == 0.001
-    assert config.scene == "office" and config.timesteps == 500 and config.gamma == 0.99
-    # fields a settings file leaves out take today's defaults (a saved config.json's
-    # take the values of its era, test_stops_are_checked_in_training...)
-    assert config.confirm_stop_m == 0.25 and config.collector == "async"
-    # a run's own config.json reads back as the same config
-    saved = tmp_path / "config.json"
-    saved.write_text(json.dumps(TINY.to_dict()))
-    assert read_train_config(saved) == TINY
-    bad = tmp_path / "bad.yml"
-    bad.write_text("reward: 3\n")
-    with pytest.raises(ValueError, match="bad.yml.*unknown"):
-        read_train_config(bad)
-
-
 def test_the_speed_benchmark_reports_training_next_to_the_env():
     from vc_gym.experiments.benchmarks.train import bench_train
 
@@ -160,7 +125,7 @@ def test_reloaded_model_gives_the_same_actions(trained):
     out, _ = trained
     agent = LearnedHomingAgent(out / "model.zip")
     again = LearnedHomingAgent(out / "model.zip")
-    env = agent.make_env()
+    env = gym.make(agent.env_id, **agent.env_kwargs)
     rng = np.random.default_rng(0)
     obs = rng.uniform(-2, 2, (20, *env.observation_space.shape)).astype(np.float32)
     a = np.stack([agent.predict(o) for o in obs])
@@ -210,30 +175,6 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
     assert result["overall"]["episodes"] == 1 and "per_episode" not in result
 
 
-@pytest.mark.parametrize(
-    "kwargs",
-    [
-        {"algo": "dqn"},
-        {"timesteps": 0},
-        {"n_envs": 1.5},
-        {"gamma": 1.5},
-        {"net_arch": (0,)},
-        {"vec_env": "ray"},
-        {"learning_rate": float("nan")},
-        {"demo_episodes": -1},
-        {"algo": "sac", "demo_episodes": 5},
-        {"confirm_stop_m": 0.0},
-        {"confirm_stop_m": float("inf")},
-        {"closeness_bonus": -1.0},
-        {"closeness_bonus": float("nan")},
-        {"min_walk_m": -0.5},
-    ],
-)
-def test_bad_train_config(kwargs):
-    with pytest.raises(ValueError):
-        TrainConfig(**kwargs)
-
-
 def test_warm_start_clones_the_expert_and_is_evaluated_before_ppo(tmp_path):
     config = replace(TINY, demo_episodes=2, save_freq=0, vec_env="dummy", collector="lockstep")
     summary = train(config, tmp_path, progress=False)
@@ -243,48 +184,6 @@ def test_warm_start_clones_the_expert_and_is_evaluated_before_ppo(tmp_path):
     assert np.isfinite(warm["action_mse"]) and np.isfinite(warm["value_mse"])
     with np.load(tmp_path / "eval" / "evaluations.npz") as ev:
         assert list(ev["timesteps"]) == [0, 32, 64]  # the clone, then PPO's evaluations
-
-
-def test_config_file_round_trip_and_errors(tmp_path):
-    assert TrainConfig.from_dict(TINY.to_dict()) == TINY
-    with pytest.raises(ValueError, match="unknown"):
-        TrainConfig.from_dict({**TINY.to_dict(), "reward": 3})
-    with pytest.raises(ValueError, match="schema"):
-        TrainConfig.from_dict({**TINY.to_dict(), "schema": 99})
-    with pytest.raises(ValueError, match="does not match"):
-        TrainConfig.from_dict({**TINY.to_dict(), "env": {"scene": "office"}})
-    schema1 = {k: v for k, v in TINY.to_dict().items() if k not in ("env", "tracker")}
-    assert TrainConfig.from_dict({**schema1, "schema": 1}) == TINY
-
-
-def test_stops_are_checked_in_training_and_old_configs_keep_their_final_stops():
-    assert TrainConfig().confirm_stop_m == 0.25 and TrainConfig().stop_time_s == 5.0
-    assert TINY.env_kwargs()["confirm_stop_m"] == 0.25
-    assert TrainConfig.from_dict(TINY.to_dict()) == TINY
-    final = replace(TINY, confirm_stop_m=None)
-    assert "confirm_stop_m" not in final.env_kwargs()
-    assert TrainConfig.from_dict(final.to_dict()) == final
-    # a config.json written before the field existed: its stops were final
-    saved_before = {k: v for k, v in final.to_dict().items() if k != "confirm_stop_m"}
-    assert TrainConfig.from_dict(saved_before) == final
-
-
-@pytest.mark.parametrize(("name", "value"), [("closeness_bonus", 10.0), ("min_walk_m", 0.5)])
-def test_optional_env_settings_and_old_configs_without_them(name, value):
-    assert getattr(TrainConfig(), name) == 0.0
-    given = replace(TINY, **{name: value})
-    assert given.env_kwargs()[name] == value
-    assert TrainConfig.from_dict(given.to_dict()) == given
-    plain = replace(TINY, **{name: 0.0})
-    assert name not in plain.env_kwargs()
-    assert TrainConfig.from_dict(plain.to_dict()) == plain
-    # a config.json written before the field existed: trained without it
-    saved_before = {k: v for k, v in plain.to_dict().items() if k != name}
-    assert TrainConfig.from_dict(saved_before) == plain
-    # what the agent's env is built with
-    env = gym.make("vc_gym/Homing-v0", **given.env_kwargs())
-    assert env.get_wrapper_attr(name) == value
-    env.close()
 
 
 def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
@@ -348,20 +247,6 @@ def test_a_bad_scene_or_tracker_in_a_config_file_fails_before_the_run_folder(
     assert value in capsys.readouterr().err and not out.exists()
 
 
-def test_places_are_checked_and_saved():
-    assert TINY.place_seeds == (0,) and TINY.places == ()
-    config = replace(TINY, places=[3, 1])
-    assert config.places == (3, 1) and config.place_seeds == (3, 1)
-    assert TrainConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
-    assert [p.name for p in config.atlas_files("run")] == [
-        "atlas-place3.npz",
-        "atlas-place1.npz",
-    ]
-    for bad in ([1, 1], [-1], "12", [0.5], 3, list(range(17))):
-        with pytest.raises(ValueError, match="places"):
-            replace(TINY, places=bad)
-
-
 def test_training_over_a_pool_of_places(tmp_path):
     config = replace(
         TINY,
@@ -409,7 +294,7 @@ def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
     assert saved["home_offset_m"] == measured["home_offset_m"]
     assert saved["env"]["home_offset_m"] == measured["home_offset_m"]
     agent = LearnedHomingAgent(tmp_path / "model.zip")  # evaluated going to the same goal
-    env = agent.make_env()
+    env = gym.make(agent.env_id, **agent.env_kwargs)
     assert env.get_wrapper_attr("home_offset_m") == pytest.approx(measured["home_offset_m"])
     env.close()
     # resumed with the same settings: the run's measured goal is kept, not measured again
@@ -417,41 +302,6 @@ def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
     assert resumed["home_offset"] is None and resumed["resumed_from"] is not None
     again = json.loads((tmp_path / "config.json").read_text())
     assert again["home_offset_m"] == measured["home_offset_m"] and again["timesteps"] == 64
-
-
-def test_goal_correction_settings():
-    # the default goal is measured and centred (README, Learned agents: learning seeds 30-32)
-    assert TrainConfig().home_offset_episodes == 10 and TrainConfig().home_offset_places == 3
-    assert TrainConfig().home_offset_centre is True and TrainConfig().home_offset_m is None
-    assert "home_offset_m" not in TrainConfig(seed=0).env_kwargs()  # until it is measured
-    assert TrainConfig(seed=2).home_offset_seeds == (2, 2_000_032, 2_000_033, 2_000_034)
-    given = replace(TINY, home_offset_m=(0.05, -0.1))
-    assert given.env_kwargs()["home_offset_m"] == [0.05, -0.1]
-    assert TrainConfig.from_dict(json.loads(json.dumps(given.to_dict()))) == given
-    assert "home_offset_m" not in TINY.env_kwargs()
-    # a config.json written before the fields existed: trained towards the tracker's home
-    saved_before = {
-        k: v for k, v in TrainConfig().to_dict().items() if not k.startswith("home_offset")
-    }
-    old = TrainConfig.from_dict(saved_before)
-    assert old.home_offset_episodes == 0 and old.home_offset_m is None
-    assert old.home_offset_centre is False
-    centred = replace(TINY, home_offset_episodes=10, home_offset_centre=True)
-    assert TrainConfig.from_dict(json.loads(json.dumps(centred.to_dict()))) == centred
-    for bad in (
-        {"home_offset_episodes": -1},
-        {"home_offset_places": 17},
-        {"home_offset_episodes": 1, "home_offset_places": 0},  # 1 episode: too few
-        {"home_offset_m": (2.0, 0.0)},
-        {"home_offset_m": (float("nan"), 0.0)},
-        {"home_offset_m": (0.1,)},
-        {"home_offset_m": "0.1,0.2"},
-        {"home_offset_centre": "yes"},
-        {"home_offset_centre": 1},
-        {"home_offset_episodes": 0},  # nothing measured to centre (centring is the default)
-    ):
-        with pytest.raises(ValueError, match="home_offset"):
-            TrainConfig(**bad)
 
 
 def test_the_command_line_asks_for_a_centred_goal():
@@ -479,7 +329,7 @@ def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
     summary = train(config, tmp_path, progress=False)
     assert summary["warm_start"]["demo_episodes"] == 1
     agent = LearnedHomingAgent(tmp_path / "model.zip")
-    env = agent.make_env()
+    env = gym.make(agent.env_id, **agent.env_kwargs)
     assert env.observation_space.shape == (15,)
     obs, _ = env.reset(seed=3)
     assert agent.predict(obs).shape == (3,)
@@ -490,3 +340,30 @@ def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
     assert TrainConfig.from_dict(saved_before).previous_action is False
     with pytest.raises(ValueError, match="previous_action"):
         TrainConfig(previous_action="yes")
+
+
+def test_names_read_from_train_that_moved_warn_and_are_the_same_objects():
+    from vc_gym.training import train as train_module
+
+    assert {"read_train_config", "latest_checkpoint", "checkpoints"} <= set(train_module.MOVED)
+    for name, module in train_module.MOVED.items():
+        moved = rf"training\.train\.{name} moved to {module.__name__}\.{name}"
+        with pytest.warns(DeprecationWarning, match=moved):
+            assert getattr(train_module, name) is getattr(module, name)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        train_module.no_such_name  # noqa: B018
+
+
+def test_what_the_command_line_imports_from_train_still_imports():
+    from vc_gym.training import config, run_folder
+
+    with pytest.warns(DeprecationWarning):
+        from vc_gym.training.train import (
+            TrainConfig,
+            check_names,
+            latest_checkpoint,
+            read_train_config,
+        )
+    assert TrainConfig is config.TrainConfig and check_names is config.check_names
+    assert read_train_config is config.read_train_config
+    assert latest_checkpoint is run_folder.latest_checkpoint

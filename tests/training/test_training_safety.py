@@ -16,42 +16,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tiny_configs import TINY_LOCAL
 
 from vc_gym.cli import build_parser, main
-from vc_gym.training import train as training
-from vc_gym.training.train import (
-    MAX_LAYER_WIDTH,
-    MAX_LAYERS,
-    MAX_N_ENVS,
-    TrainConfig,
-    check_names,
-    check_new_run_dir,
-    continue_run,
-    latest_checkpoint,
-    read_train_config,
-    train,
-)
-
-#: One env in this process: the quickest run that still writes checkpoints (32, 64),
-#: evaluations and a best model; the tracker given as a {"type": ...} dict.
-TINY_LOCAL = TrainConfig(
-    timesteps=64,
-    n_envs=1,
-    vec_env="dummy",
-    collector="lockstep",
-    learn_time_s=0.2,
-    n_steps=32,
-    batch_size=32,
-    max_homing_s=3.0,
-    stop_time_s=0.3,
-    eval_freq=32,
-    eval_episodes=1,
-    save_freq=32,
-    demo_episodes=0,
-    home_offset_episodes=0,
-    home_offset_centre=False,
-    tracker={"type": "grid"},
-)
+from vc_gym.training import run_folder
+from vc_gym.training.config import MAX_N_ENVS, TrainConfig, check_names, read_train_config
+from vc_gym.training.run_folder import check_new_run_dir, latest_checkpoint
+from vc_gym.training.safe_load import MAX_LAYER_WIDTH, MAX_LAYERS
+from vc_gym.training.train import continue_run, train
 
 
 @pytest.fixture(scope="module")
@@ -116,7 +88,7 @@ def test_a_folder_with_only_atlases_or_other_files_may_take_a_new_run(tmp_path):
 
 
 def test_a_sweep_refuses_a_single_runs_folder(run, tmp_path):
-    from vc_gym.jobs.runner import LocalBackend
+    from vc_gym.jobs.backends import LocalBackend
     from vc_gym.training.sweep import run_train_sweep
 
     out = _copy(run[0], tmp_path / "run")
@@ -425,7 +397,7 @@ def test_a_large_or_malformed_training_log_is_refused_on_resume(run, tmp_path, m
     with pytest.raises(ValueError, match=r"train_log.json: per_episode\[0\]"):
         train(TINY_LOCAL, out, progress=False, resume=True)
     log.write_text(json.dumps({"per_episode": []}) + " " * 100)
-    monkeypatch.setattr(training, "MAX_TRAIN_LOG_BYTES", 50)
+    monkeypatch.setattr(run_folder, "MAX_TRAIN_LOG_BYTES", 50)
     with pytest.raises(ValueError, match=r"train_log.json.*larger than 50 bytes"):
         train(TINY_LOCAL, out, progress=False, resume=True)
 

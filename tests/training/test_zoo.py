@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from vc_gym.hyperparams import zoo_hyperparams
-from vc_gym.training.train import TrainConfig
+from vc_gym.training.config import TrainConfig
 
 
 def _policy_kwargs(text: str) -> dict:

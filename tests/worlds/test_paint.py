@@ -5,7 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.worlds.paint import hsv, random_colour, smooth_noise, smoothstep, value_noise
+from vc_gym.worlds.paint import (
+    hsv,
+    random_colour,
+    smooth_noise,
+    smoothstep,
+    to_uint8,
+    value_noise,
+)
 
 
 @pytest.mark.parametrize(
@@ -79,3 +86,11 @@ def test_smooth_noise_deterministic_per_seed_and_about_unit_spread() -> None:
     assert a.shape == (120, 200) and a.dtype == np.float32
     assert 0.3 < float(a.std()) < 2.0
     assert np.abs(np.diff(a, axis=1)).max() < 0.5  # no pixel-scale detail
+
+
+def test_to_uint8_rounds_to_nearest_and_clips() -> None:
+    img = np.array([[-5.0, 0.4, 0.6, 127.5, 254.4, 255.5, 1e6]], np.float32)
+    out = to_uint8(img)
+    assert out.dtype == np.uint8 and out.shape == img.shape
+    assert out.tolist() == [[0, 0, 1, 128, 254, 255, 255]]
+    assert img[0, -1] == 1e6  # the input is not changed

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -108,6 +108,10 @@ def read_agent_config(path: Path, allow_imports: bool = False) -> tuple[str, dic
 class LearnedHomingAgent:
     """A trained homing agent, loaded from ``DIR/model.zip`` and ``DIR/config.json``.
 
+    It acts in ``vc_gym/Homing-v0`` (:attr:`env_id`) with the settings it was trained
+    with (:attr:`env_kwargs`, from ``config.json``); whoever runs it builds that env and
+    asks for :meth:`policy`.
+
     Parameters
     ----------
     model_path : path
@@ -116,6 +120,11 @@ class LearnedHomingAgent:
         Let the ``config.json`` name a tracker by import path (``"module:attr"``), which
         imports that module: only for files you trust (:func:`read_agent_config`).
     """
+
+    #: The registered env the agent acts in.
+    env_id: ClassVar[str] = "vc_gym/Homing-v0"
+    #: What it observes: ``vc_gym/Homing-v0``'s feature vector.
+    observation: ClassVar[str] = "features"
 
     def __init__(self, model_path: str | os.PathLike, allow_imports: bool = False):
         path = Path(model_path)
@@ -133,37 +142,21 @@ class LearnedHomingAgent:
         except Exception as exc:  # SB3 raises many kinds on a corrupt zip
             raise ValueError(f"{path}: cannot load the {self.algo} model: {exc}") from exc
         self.path = path
+        #: The ``config.json`` the agent's settings came from.
+        self.config_path = cfg_path
 
     @property
     def scene(self) -> str:
         """The scene the agent was trained in."""
         return str(self.env_kwargs.get("scene", "robolab"))
 
-    def make_env(self, **overrides: Any) -> gym.Env:
-        """``vc_gym/Homing-v0`` as the agent was trained on it, with ``overrides``
-        (e.g. ``tracker=``, ``stop_time_s=5.0``, ``relearn=``)."""
-        return gym.make("vc_gym/Homing-v0", **{**self.env_kwargs, **overrides})
+    def policy(self, env: gym.Env) -> LearnedHomingAgent:
+        """The policy acting in ``env`` (built from :attr:`env_id` and :attr:`env_kwargs`):
+        the loaded model itself."""
+        return self
 
-    def check_env(self) -> None:
-        """Build (and close) the agent's env once, so that a ``config.json`` whose env
-        arguments the env refuses (an unknown key, scene or value) fails here, naming
-        the file, not later in every worker.
-
-        Raises
-        ------
-        ValueError
-            Naming ``config.json`` and what the env said.
-        """
-        cfg_path = self.path.with_name("config.json")
-        try:
-            env = self.make_env()
-        except Exception as exc:  # noqa: BLE001 - TypeError (a key), ValueError (a value)
-            cause = exc.__cause__ or exc
-            raise ValueError(
-                f"{cfg_path}: its env arguments are refused by vc_gym/Homing-v0: "
-                f"{type(cause).__name__}: {str(cause).split(' was raised from')[0]}"
-            ) from None
-        env.close()
+    def reset(self) -> None:
+        """Start of an episode (the policy keeps no state between decisions)."""
 
     def predict(self, obs: np.ndarray) -> np.ndarray:
         """Deterministic action for one feature vector."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.poses import body_to_world, world_to_body
 from vc_gym.validation import nonnegative_float, positive_float
 
-__all__ = ["ScriptedHomingPolicy"]
+__all__ = ["ScriptedHomingAgent", "ScriptedHomingPolicy"]
 
 
 class ScriptedHomingPolicy:
@@ -242,3 +243,31 @@ class ScriptedHomingPolicy:
     def is_still(action: np.ndarray, threshold: float = 0.05) -> bool:
         """No body motion commanded (the head may move)."""
         return bool(np.all(np.abs(np.asarray(action)[:3]) <= threshold))
+
+
+class ScriptedHomingAgent:
+    """The scripted homing behaviour as an agent: the env it acts in and its policy.
+
+    It acts in ``vc_gym/LearnThenHome-v0`` (:attr:`env_id`) seen through
+    :class:`~vc_gym.envs.CompassObservation` (:attr:`observation` ``"compass"``); whoever
+    runs it builds that env and asks for :meth:`policy`.
+
+    Parameters
+    ----------
+    **policy_kwargs
+        Keyword arguments of :class:`ScriptedHomingPolicy`.
+    """
+
+    #: The registered env the agent acts in.
+    env_id: ClassVar[str] = "vc_gym/LearnThenHome-v0"
+    #: What it observes: the task's observation with what ``CompassObservation`` adds.
+    observation: ClassVar[str] = "compass"
+
+    def __init__(self, **policy_kwargs: Any) -> None:
+        self.policy_kwargs = dict(policy_kwargs)
+        #: Its own settings of the env (none: the task's).
+        self.env_kwargs: dict[str, Any] = {}
+
+    def policy(self, env: Any) -> ScriptedHomingPolicy:
+        """A fresh :class:`ScriptedHomingPolicy` driving ``env``."""
+        return ScriptedHomingPolicy.for_env(env, **self.policy_kwargs)

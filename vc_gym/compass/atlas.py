@@ -19,12 +19,8 @@ import numpy as np
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import MAX_MAP_BYTES, CompassConfig
-from vc_gym.compass.visual_compass import (
-    CompassEstimate,
-    VisualCompass,
-    _estimates_of,
-    _log_likelihoods_of,
-)
+from vc_gym.compass.likelihood import log_likelihoods
+from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass, _estimates_of
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.exposure import SessionLight
 from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
@@ -228,7 +224,7 @@ class CompassAtlas:
             features = first._sector_features(image, camera, g)
             delta_t, base = self._stacked_tables()
             maps = None if every else which
-            lls = _log_likelihoods_of(first.config, *features, delta_t, base, maps)
+            lls = log_likelihoods(first.config, *features, delta_t, base, maps)
             ests = _estimates_of(compasses, *features, lls)
         else:
             ests = [vc.estimate(image, camera, gain=gain) for vc in compasses]

@@ -49,6 +49,22 @@ class LightMap:
         self.level_sum += other.level_sum
         self.columns += other.columns
 
+    def resampled(self, source: np.ndarray) -> LightMap:
+        """A light map whose sector ``s`` holds a copy of sector ``source[s]``."""
+        out = LightMap(self.level_sum.size)
+        out.level_sum = self.level_sum[source]
+        out.columns = self.columns[source]
+        return out
+
+    def regrouped(self, target: np.ndarray) -> LightMap:
+        """A light map whose sector ``t`` holds the sums of every sector ``s`` with
+        ``target[s] == t`` (sectors no source lands on stay unlit)."""
+        n = self.level_sum.size
+        out = LightMap(n)
+        out.level_sum = np.bincount(target, weights=self.level_sum, minlength=n)
+        out.columns = np.bincount(target, weights=self.columns, minlength=n)
+        return out
+
     def heading_gains(
         self,
         levels: np.ndarray,

@@ -8,7 +8,7 @@ far each sector's wall point is, it can be re-drawn for any nearby position: eve
 moves to the direction its wall point has from there (:meth:`ParallaxMap.at`).
 
 The distances are learned without any geometry: the robot also learns short turns a
-little away from the spot (the improved mode's turns around a spot), and each sector's
+little away from the spot (the spot-grid mode's turns around a spot), and each sector's
 distance is the one at which the spot's histograms, moved to where each of those turns
 would see them, fit that turn best (:func:`learn_depths`). The turns around the spot are
 kept as maps of their own and are re-drawn with the spot's turn, from where each was

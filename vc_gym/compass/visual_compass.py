@@ -3,62 +3,69 @@
 A :class:`VisualCompass` learns, at one spot, how often each colour-class transition
 appears in each direction (a histogram map, eq. 1-2 and 6) and answers, for a new
 camera image, a log-likelihood for every candidate heading (eq. 5, 15-16).
+
+The class holds the map and checks its inputs; the work is done by one module per
+concept: :mod:`~vc_gym.compass.scan_geometry` (which columns fall into which
+sector), :mod:`~vc_gym.compass.sector_map` (how frames add to the map),
+:mod:`~vc_gym.compass.likelihood` (features, log tables, log-likelihoods,
+estimates), :mod:`~vc_gym.compass.light_gain` (the exposure correction) and
+:mod:`~vc_gym.compass.map_files` (arrays and ``.npz`` files).
 """
 
 from __future__ import annotations
 
-import math
 import os
-from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from vc_gym.angles import circular_std_rows, peak_headings
 from vc_gym.compass.camera import Camera
-from vc_gym.compass.colors import MAX_LIGHT_LEVEL, ColorClasses
+from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
-from vc_gym.compass.features import (
-    NOISE_CHANGE_RATIO,
-    ScanGrid,
-    change_ratio,
-    column_transition_counts,
-    log2_bin,
-    scan_grid,
+from vc_gym.compass.features import column_transition_counts
+from vc_gym.compass.light_gain import (
+    REFERENCE_EXPOSURES,
+    colour_fitting_levels,
+    exposure_corrected,
+    frame_gain_of,
+    heading_gain_steps,
+    profile_log_likelihood,
+    scaled_to_reference,
+    step_gain,
+    upper_half,
 )
 from vc_gym.compass.light_map import LightMap
-from vc_gym.errors import MapFileError, NotLearnedError
-from vc_gym.exposure import (
-    GAIN_STEP_STOPS,
-    column_levels,
-    gain_table,
-    mean_linear_level,
-    quantized_stops,
-    rounded_gain,
+from vc_gym.compass.likelihood import (
+    heading_estimates,
+    log_likelihoods,
+    log_tables,
+    remapped_log_likelihoods,
+    sector_features,
 )
+
+# the map file's constants, re-exported: importable from the compass' module too
+from vc_gym.compass.map_files import MAP_SCHEMA as MAP_SCHEMA
+from vc_gym.compass.map_files import MAP_SCHEMA_VERSION as MAP_SCHEMA_VERSION
+from vc_gym.compass.map_files import MAX_LEARNED_SIZES as MAX_LEARNED_SIZES
+from vc_gym.compass.map_files import (
+    MapContents,
+    check_learned_sizes,
+    map_arrays,
+    read_config_and_colors,
+    read_map_contents,
+    read_map_file,
+    write_map_file,
+)
+from vc_gym.compass.scan_geometry import ScanGeometry, ScanGeometryCache, column_sectors
+from vc_gym.compass.sector_map import add_frame, checked_sectors, regrouped_counts
+from vc_gym.errors import NotLearnedError
+from vc_gym.exposure import column_levels, rounded_gain
 from vc_gym.images import check_image
-from vc_gym.persistence import json_array, load_npz_checked, read_json_array, save_npz_atomic
 from vc_gym.validation import positive_float
 
 __all__ = ["VisualCompass", "CompassEstimate"]
-
-MAP_SCHEMA = "vc_gym.VisualCompass"
-#: Exposure modes that keep the colour-fitting images' mean light as a reference level.
-REFERENCE_EXPOSURES = ("mean", "session")
-MAP_SCHEMA_VERSION = 1
-#: Pseudo-count per bin of the heading-independent (pooled) histogram.
-_POOL_PSEUDOCOUNT = 0.5
-_CACHE_SIZE = 16
-#: Most distinct frame sizes a map file may list: a map learns from one camera or a
-#: few; each listed size becomes a Python object when loaded (about 150 bytes), and an
-#: entry of 64 MiB could otherwise list 4 million of them.
-MAX_LEARNED_SIZES = 4096
-# Table rows gathered at once when scoring a frame against several maps: a few hundred
-# kilobytes stay in the cache; one gather of every row (16 MB for 24 maps) made the
-# scoring memory-bound and 1.6 times slower (measured, see _group_sums).
-_GATHER_BYTES = 1 << 19
 
 
 @dataclass(frozen=True)
@@ -91,24 +98,6 @@ class CompassEstimate:
     score: float
     n_sectors: int
     log_likelihood: np.ndarray
-
-
-@dataclass(frozen=True)
-class _Geometry:
-    """Everything about an image size + camera that does not depend on pixel values."""
-
-    grid: ScanGrid
-    row_slice: slice
-    col_slice: slice
-    # (P*K,) each: the scanned columns ``first[r] <= u < stop[r]`` fall into relative
-    # sector k at phase p, r = p*K + k (columns look at monotonically falling directions)
-    first_col: np.ndarray
-    stop_col: np.ndarray
-    kmin: int
-    n_rel: int  # K
-    heading_phase: np.ndarray  # (n_headings,) phase index of each heading
-    heading_sector: np.ndarray  # (n_headings,) sector of each heading's optical axis
-    roll_index: np.ndarray  # (K, S): sector (s0 + k + kmin) mod S
 
 
 class VisualCompass:
@@ -159,10 +148,10 @@ class VisualCompass:
         self._frames = 0
         self._sizes: set[tuple[int, int]] = set()  # (H, W) of the learned frames
         self._tables: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._geom_cache: OrderedDict[tuple, _Geometry] = OrderedDict()
         h = np.arange(cfg.n_headings, dtype=np.float64) * cfg.heading_step_deg
         h.setflags(write=False)
         self._headings = h
+        self._geometries = ScanGeometryCache(cfg, h)
 
     # ------------------------------------------------------------------ properties
     @property
@@ -249,7 +238,7 @@ class VisualCompass:
         ref = 0.0
         if self.config.exposure in REFERENCE_EXPOSURES:
             # reference level from the upper halves (what the compass scans at pitch 0)
-            levels = [mean_linear_level(im[: max(im.shape[0] // 2, 1)]) for im in images]
+            levels = colour_fitting_levels(images)
             ref = float(np.mean(levels))
             if ref <= 0:
                 raise ValueError(
@@ -258,7 +247,7 @@ class VisualCompass:
                 )
         if self.config.exposure == "mean":
             images = [
-                self._apply_gain(im[: max(im.shape[0] // 2, 1)], lvl, ref)
+                scaled_to_reference(upper_half(im), lvl, ref)
                 for im, lvl in zip(images, levels, strict=True)
             ]
         colors = ColorClasses.fit(
@@ -285,80 +274,16 @@ class VisualCompass:
         self._tables = None
 
     # ------------------------------------------------------------------ features
-    def _geometry(self, camera: Camera, width: int, height: int) -> _Geometry:
-        key = (width, height, camera.hfov_deg, camera.pitch_deg, camera.principal_point)
-        geom = self._geom_cache.get(key)
-        if geom is not None:
-            self._geom_cache.move_to_end(key)
-            return geom
-        cfg = self.config
-        row_step, col_step = cfg.grid_steps
-        grid = scan_grid(camera, width, height, row_step, col_step)
-        if grid.rows.size:
-            row_slice = slice(int(grid.rows[0]), int(grid.rows[-1]) + 1, row_step)
-        else:
-            row_slice = slice(0, 0)
-        col_slice = slice(int(grid.cols[0]), width, col_step)
-        delta = cfg.sector_deg
-        s_total = cfg.n_sectors
-        # heading = s0 * delta + phase, 0 <= phase < delta; a column at offset r then
-        # falls into sector s0 + floor((phase + r) / delta)
-        hs = self._headings
-        s0 = np.floor(hs / delta + 1e-9).astype(np.int64)
-        phase = np.round(hs - s0 * delta, 9)
-        phases, heading_phase = np.unique(phase, return_inverse=True)
-        k = np.floor((phases[:, None] + grid.offsets_deg[None, :]) / delta).astype(np.int64)
-        kmin = int(k.min())
-        n_rel = int(k.max()) - kmin + 1
-        n_p, n_u = k.shape
-        # the columns of one (phase, relative sector) are a contiguous run: their counts
-        # are a difference of cumulative sums (a product with a 0/1 matrix instead makes
-        # OpenBLAS start a second thread that then spins on a core of its own)
-        rows = np.arange(n_p)[:, None] * n_rel + (k - kmin)  # (P, U)
-        if np.any(np.diff(k, axis=1) > 0):
-            raise RuntimeError("scan columns must look at falling directions")
-        first_col = np.zeros(n_p * n_rel, dtype=np.intp)
-        stop_col = np.zeros(n_p * n_rel, dtype=np.intp)
-        cols = np.broadcast_to(np.arange(n_u), rows.shape)
-        np.maximum.at(stop_col, rows.ravel(), cols.ravel() + 1)
-        first_col[:] = n_u
-        np.minimum.at(first_col, rows.ravel(), cols.ravel())
-        empty = stop_col == 0
-        first_col[empty] = 0
-        roll = (np.arange(s_total)[None, :] + np.arange(n_rel)[:, None] + kmin) % s_total
-        geom = _Geometry(
-            grid=grid,
-            row_slice=row_slice,
-            col_slice=col_slice,
-            first_col=first_col,
-            stop_col=stop_col,
-            kmin=kmin,
-            n_rel=n_rel,
-            heading_phase=heading_phase.astype(np.intp),
-            heading_sector=s0 % s_total,
-            roll_index=roll,
-        )
-        self._geom_cache[key] = geom
-        if len(self._geom_cache) > _CACHE_SIZE:
-            self._geom_cache.popitem(last=False)
-        return geom
-
-    @staticmethod
-    def _apply_gain(pixels: np.ndarray, level: float, ref: float) -> np.ndarray:
-        """Scale linear light so that a frame at ``level`` comes out at ``ref``."""
-        if level <= 0:
-            return pixels
-        return np.take(gain_table(ref / level), pixels)
+    def _geometry(self, camera: Camera, width: int, height: int) -> ScanGeometry:
+        """The (cached) scan geometry of ``width`` x ``height`` frames of ``camera``."""
+        return self._geometries.get(camera, width, height)
 
     def _scanned_classes(self, pixels: np.ndarray, gain: float = 1.0) -> np.ndarray:
         """``(R, U)`` class ids of the scanned ``pixels`` after the exposure correction:
         ``exposure="mean"`` scales the frame to the reference level, otherwise the
         linear light is multiplied by ``gain``."""
         assert self._colors is not None
-        if self.config.exposure == "mean":
-            pixels = self._apply_gain(pixels, mean_linear_level(pixels), self._exposure_ref)
-        elif gain != 1.0:
-            pixels = np.take(gain_table(gain), pixels)
+        pixels = exposure_corrected(pixels, self.config.exposure, self._exposure_ref, gain)
         return self._colors.classify_pixels(pixels)
 
     def _column_counts(self, classes: np.ndarray) -> np.ndarray:
@@ -395,34 +320,22 @@ class VisualCompass:
         ------
         ValueError
             On an invalid image or camera, or a frame of a new size when the map has
-            learned :data:`MAX_LEARNED_SIZES` sizes (its file could not be loaded).
+            learned :data:`~vc_gym.compass.map_files.MAX_LEARNED_SIZES` sizes (its
+            file could not be loaded).
         """
         self._checked(image, camera, need_map=False)
         h, w = image.shape[:2]
-        _check_sizes(self._sizes | {(h, w)})
+        check_learned_sizes(self._sizes | {(h, w)})
         geom = self._geometry(camera, w, h)
         pixels = image[geom.row_slice, geom.col_slice]
         colcounts = self._column_counts(self._scanned_classes(pixels))
         cfg = self.config
-        sector = (
-            np.floor((camera.yaw_deg + geom.grid.offsets_deg) / cfg.sector_deg + 1e-9).astype(
-                np.int64
-            )
-            % cfg.n_sectors
+        sector = column_sectors(
+            camera.yaw_deg, geom.grid.offsets_deg, cfg.sector_deg, cfg.n_sectors
         )
-        c2 = colcounts.shape[1]
-        flat = (sector[:, None] * c2 + np.arange(c2)[None, :]).ravel()
-        counts = np.bincount(flat, weights=colcounts.ravel(), minlength=cfg.n_sectors * c2).reshape(
-            cfg.n_sectors, c2
-        )
-        total = counts.sum(axis=1)
-        seen = np.flatnonzero(total > 0)
+        seen = add_frame(self._counts, self._n_obs, colcounts, sector)
         if seen.size == 0:
             return 0
-        z = counts[seen] / total[seen, None]
-        bins = log2_bin(z, cfg.n_bins)
-        self._counts[seen[:, None], np.arange(c2)[None, :], bins] += 1.0
-        self._n_obs[seen] += 1.0
         if cfg.exposure == "map":
             self._light.add(sector, column_levels(pixels))
         self._frames += 1
@@ -442,7 +355,8 @@ class VisualCompass:
         ------
         ValueError
             If the configs or colour classes differ, ``other`` is not a compass, or
-            together they learned frames of more than :data:`MAX_LEARNED_SIZES` sizes.
+            together they learned frames of more than
+            :data:`~vc_gym.compass.map_files.MAX_LEARNED_SIZES` sizes.
         """
         if not isinstance(other, VisualCompass):
             raise ValueError(f"can only merge a VisualCompass, got {type(other).__name__}")
@@ -450,7 +364,7 @@ class VisualCompass:
             raise ValueError("cannot merge maps learned with different CompassConfigs")
         if not self.shares_colors(other):
             raise ValueError("cannot merge maps learned with different colour classes")
-        _check_sizes(self._sizes | other._sizes)
+        check_learned_sizes(self._sizes | other._sizes)
         self._counts += other._counts
         self._n_obs += other._n_obs
         self._light.merge(other._light)
@@ -503,37 +417,16 @@ class VisualCompass:
         ValueError
             If ``source`` is not ``(n_sectors,)`` integers in ``[0, n_sectors)``.
         """
-        source = self._checked_sectors("source", source)
-        out = self._like()
+        source = checked_sectors("source", source, self.config.n_sectors)
+        out = self._empty_copy()
         out._counts = self._counts[source]
         out._n_obs = self._n_obs[source]
-        out._light.level_sum = self._light.level_sum[source]
-        out._light.columns = self._light.columns[source]
+        out._light = self._light.resampled(source)
         return out
 
-    def _checked_sectors(self, name: str, sectors: np.ndarray, rows: bool = False) -> np.ndarray:
-        """``sectors`` as an integer array of map sectors: ``(n_sectors,)``, or
-        ``(N, n_sectors)`` with ``rows``; a clear ``ValueError`` otherwise."""
-        n = self.config.n_sectors
-        sectors = np.asarray(sectors)
-        shape = f"(N, {n})" if rows else f"({n},)"
-        if (
-            sectors.ndim != (2 if rows else 1)
-            or sectors.shape[-1] != n
-            or not np.issubdtype(sectors.dtype, np.integer)
-        ):
-            raise ValueError(
-                f"{name} must be an integer array of shape {shape}, got "
-                f"{sectors.dtype} {sectors.shape}"
-            )
-        if sectors.size and (sectors.min() < 0 or sectors.max() >= n):
-            raise ValueError(
-                f"{name} sectors must lie in [0, {n}), got {sectors.min()}..{sectors.max()}"
-            )
-        return sectors
-
-    def _like(self) -> VisualCompass:
-        """An empty map with this one's config, colours, exposure, frames and sizes."""
+    def _empty_copy(self) -> VisualCompass:
+        """A compass with an empty map and this one's config, colours, exposure
+        reference, frame count and frame sizes (the map is filled in by the caller)."""
         out = VisualCompass(self.config, self._colors)
         out._exposure_ref = self._exposure_ref
         out._frames = self._frames
@@ -560,117 +453,53 @@ class VisualCompass:
         ValueError
             If ``target`` has another shape, is not integer or is out of range.
         """
-        n = self.config.n_sectors
-        target = self._checked_sectors("target", target)
-        out = self._like()
-        np.add.at(out._counts, target, self._counts)
-        out._n_obs = np.bincount(target, weights=self._n_obs, minlength=n).astype(np.float64)
-        out._light.level_sum = np.bincount(target, weights=self._light.level_sum, minlength=n)
-        out._light.columns = np.bincount(target, weights=self._light.columns, minlength=n)
+        target = checked_sectors("target", target, self.config.n_sectors)
+        out = self._empty_copy()
+        out._counts, out._n_obs = regrouped_counts(self._counts, self._n_obs, target)
+        out._light = self._light.regrouped(target)
         return out
 
     # ------------------------------------------------------------------ likelihood
     def _log_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(delta_t, base, log_abs)`` for the current map (cached until it changes).
-
-        ``log_abs[s, ij, b]`` is the smoothed log-probability of bin ``b``;
-        ``ratio = log_abs - log_pool``; ``base[s]`` sums the ratio of the empty bin
-        over all pairs and ``delta_t[ij * n + b, s]`` is the ratio minus that of the
-        empty bin, so that only non-zero frequencies need a table read.
-        """
-        if self._tables is not None:
-            return self._tables
-        cfg = self.config
-        n = cfg.n_bins
-        counts = self._counts
-        pooled = counts.sum(axis=0) + _POOL_PSEUDOCOUNT  # (c2, n)
-        p_pool = pooled / pooled.sum(axis=1, keepdims=True)
-        kappa = cfg.smoothing
-        # in place where the result replaces its input: a map-sized array costs
-        # 8 bytes per count, and at most two live beside the counts and delta_t
-        # (CompassConfig.memory_bytes)
-        log_abs = counts + kappa * p_pool[None]
-        log_abs /= self._n_obs[:, None, None] + kappa
-        np.log(log_abs, out=log_abs)
-        delta = log_abs - np.log(p_pool)[None]  # the log-ratio against the pooled model
-        last = delta[:, :, n - 1 : n].copy()
-        base = last[:, :, 0].sum(axis=1)  # (S,)
-        delta -= last  # (S, c2, n)
-        delta_t = np.ascontiguousarray(delta.reshape(delta.shape[0], -1).T)  # (c2*n, S)
-        del delta
-        self._tables = (delta_t, base, log_abs)
+        """``(delta_t, base, log_abs)`` of the current map
+        (:func:`~vc_gym.compass.likelihood.log_tables`, cached until the map changes)."""
+        if self._tables is None:
+            self._tables = log_tables(self.config, self._counts, self._n_obs)
         return self._tables
 
     def _sector_features(
         self, image: np.ndarray, camera: Camera, gain: float = 1.0
-    ) -> tuple[_Geometry, np.ndarray, np.ndarray]:
-        """Counts per (phase, relative sector, pair) and which of them saw anything.
-
-        A frame without a single change of colour class above the horizon (a black,
-        covered or overexposed frame, a blank wall) says nothing about the heading: it
-        gives no counts at all, so it is treated like a frame that sees nothing above
-        the horizon (a flat log-likelihood), not as a confident match of the maps'
-        "no change" statistics. So does a frame of noise, whose classes change between
-        neighbours as often as those of independent pixels
-        (:data:`~vc_gym.compass.features.NOISE_CHANGE_RATIO`): its transitions are
-        chance, and matched against the maps they would still pick some heading
-        confidently.
-        """
+    ) -> tuple[ScanGeometry, np.ndarray, np.ndarray]:
+        """The frame's scan geometry and its counts per (phase, relative sector, pair)
+        and their totals (:func:`~vc_gym.compass.likelihood.sector_features`)."""
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
         return (geom, *self._features_of(image[geom.row_slice, geom.col_slice], geom, gain))
 
     def _features_of(
-        self, pixels: np.ndarray, geom: _Geometry, gain: float = 1.0
+        self, pixels: np.ndarray, geom: ScanGeometry, gain: float = 1.0
     ) -> tuple[np.ndarray, np.ndarray]:
         """``(counts, total)`` of :meth:`_sector_features` from the scanned pixels."""
-        classes = self._scanned_classes(pixels, gain)
-        colcounts = self._column_counts(classes)
-        ratio = change_ratio(classes, self.config.n_colors)
-        if ratio == 0.0 or ratio >= NOISE_CHANGE_RATIO:  # no class change at all, or noise
-            colcounts = np.zeros_like(colcounts)
-        # integer counts in float32: the cumulative sums and their differences are exact
-        cum = np.zeros((colcounts.shape[0] + 1, colcounts.shape[1]), dtype=colcounts.dtype)
-        np.cumsum(colcounts, axis=0, out=cum[1:])
-        counts = cum[geom.stop_col] - cum[geom.first_col]  # (P*K, c2)
-        total = counts.sum(axis=1)
-        return counts, total
+        return sector_features(self._scanned_classes(pixels, gain), geom, self.config)
 
     def _light_profile(
         self, image: np.ndarray, camera: Camera
-    ) -> tuple[np.ndarray, tuple[_Geometry, np.ndarray, np.ndarray], int]:
+    ) -> tuple[np.ndarray, tuple[ScanGeometry, np.ndarray, np.ndarray], int]:
         """``exposure="map"``: log-likelihood over headings, each heading's features
         classified with the gain that brings the frame to the light the map learned in
-        the directions that heading puts in view (see :mod:`vc_gym.compass.light_map`).
+        the directions that heading puts in view (see :mod:`vc_gym.compass.light_gain`).
 
         Returns the log-likelihoods, and the sector features and the gain (in steps of
-        :data:`~vc_gym.compass.light_map.GAIN_STEP_STOPS`) of the best heading.
+        :data:`~vc_gym.exposure.GAIN_STEP_STOPS`) of the best heading.
         """
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
         pixels = image[geom.row_slice, geom.col_slice]
-        gains = self._light.heading_gains(
-            column_levels(pixels),
-            geom.first_col,
-            geom.stop_col,
-            geom.n_rel,
-            geom.heading_phase,
-            geom.roll_index[:, geom.heading_sector],
+        ll, best_features, best = profile_log_likelihood(
+            heading_gain_steps(self._light, pixels, geom),
+            lambda gain: self._features_of(pixels, geom, gain),
+            lambda features: self._log_likelihood_of(geom, *features),
         )
-        steps = quantized_stops(gains)
-        ll = np.empty(steps.size)
-        # only the features of the best heading so far are kept (a frame has 5-15
-        # gains, each a (phases x sectors in view x pairs) array); the best is the
-        # first heading of the largest log-likelihood, as numpy.argmax finds it
-        best, best_at, best_features = 0, steps.size, None
-        for k in np.unique(steps).tolist():
-            features = self._features_of(pixels, geom, 2.0 ** (k * GAIN_STEP_STOPS))
-            at = np.flatnonzero(steps == k)
-            ll[at] = self._log_likelihood_of(geom, *features)[at]
-            first = int(at[np.argmax(ll[at])])
-            if best_features is None or (ll[first], -first) > (ll[best_at], -best_at):
-                best, best_at, best_features = k, first, features
-        assert best_features is not None
         return ll, (geom, *best_features), best
 
     def log_likelihood(
@@ -710,13 +539,12 @@ class VisualCompass:
         )
 
     def _log_likelihood_of(
-        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
+        self, geom: ScanGeometry, counts: np.ndarray, total: np.ndarray
     ) -> np.ndarray:
         """Log-likelihood over headings from sector features (see log_likelihood)."""
         delta_t, base, _ = self._log_tables()
-        return _log_likelihoods_of(
-            self.config, geom, counts, total, delta_t[:, None, :], base[None]
-        )[0]
+        lls = log_likelihoods(self.config, geom, counts, total, delta_t[:, None, :], base[None])
+        return lls[0]
 
     def log_likelihood_remapped(
         self,
@@ -751,19 +579,13 @@ class VisualCompass:
         self._checked(image, camera, need_map=True)
         if self.config.exposure == "map":
             raise ValueError('log_likelihood_remapped does not support exposure="map"')
-        remap = self._checked_sectors("sector_maps", sector_maps, rows=True)
+        remap = checked_sectors("sector_maps", sector_maps, self.config.n_sectors, rows=True)
         gain = self._checked_gain(gain)
         geom, counts, total = self._sector_features(
             image, camera, self._gain_for(image, camera, gain)
         )
         delta_t, base, _ = self._log_tables()
-        per_group = _group_scores(self.config, geom, counts, total, delta_t[:, None, :], base[None])
-        if per_group is None:
-            return np.zeros((remap.shape[0], geom.heading_phase.size))
-        idx = remap[:, geom.roll_index]  # (N, K, S): map sector of relative k at start s0
-        k = np.arange(geom.n_rel)[None, :, None]
-        by_start = per_group[:, k, 0, idx].sum(axis=2)  # (P, N, S)
-        return _by_heading(self.config, geom, by_start.transpose(2, 0, 1))
+        return remapped_log_likelihoods(self.config, geom, counts, total, delta_t, base, remap)
 
     def estimate(
         self, image: np.ndarray, camera: Camera, gain: float | None = None
@@ -782,6 +604,14 @@ class VisualCompass:
             *self._sector_features(image, camera, self._gain_for(image, camera, gain))
         )
 
+    def _estimate_of(
+        self, geom: ScanGeometry, counts: np.ndarray, total: np.ndarray
+    ) -> CompassEstimate:
+        """:meth:`estimate` from sector features."""
+        ll = self._log_likelihood_of(geom, counts, total)
+        return _estimates_of([self], geom, counts, total, ll[None])[0]
+
+    # ------------------------------------------------------------------ light gain
     def frame_gain(self, image: np.ndarray, camera: Camera) -> float:
         """The gain ``exposure="mean"`` applies to this frame (beyond the paper).
 
@@ -800,8 +630,7 @@ class VisualCompass:
             raise NotLearnedError("call fit_colors() before frame_gain()")
         h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
-        level = mean_linear_level(image[geom.row_slice, geom.col_slice])
-        return self._exposure_ref / level if level > 0 else math.inf
+        return frame_gain_of(image[geom.row_slice, geom.col_slice], self._exposure_ref)
 
     def _gain_for(self, image: np.ndarray, camera: Camera, gain: float | None) -> float:
         """The gain a checked ``gain`` argument means: itself, or without one 1, except
@@ -824,7 +653,7 @@ class VisualCompass:
         if self.config.exposure != "map":
             raise ValueError(f"light_gain needs exposure='map', not {self.config.exposure!r}")
         self._checked(image, camera, need_map=True)
-        return float(2.0 ** (self._light_profile(image, camera)[2] * GAIN_STEP_STOPS))
+        return step_gain(self._light_profile(image, camera)[2])
 
     def _checked_gain(self, gain: float | None) -> float | None:
         if gain is None:
@@ -833,20 +662,13 @@ class VisualCompass:
             raise ValueError("exposure='mean' sets its own gain per frame: pass gain=None")
         return positive_float("gain", gain)
 
-    def _estimate_of(
-        self, geom: _Geometry, counts: np.ndarray, total: np.ndarray
-    ) -> CompassEstimate:
-        """:meth:`estimate` from sector features."""
-        ll = self._log_likelihood_of(geom, counts, total)
-        return _estimates_of([self], geom, counts, total, ll[None])[0]
-
     # ------------------------------------------------------------------ persistence
     def save(self, path: str | os.PathLike) -> Path:
         """Save config, colour classes and map to an ``.npz`` file, atomically.
 
         Returns the path written (``.npz`` appended if missing).
         """
-        return save_npz_atomic(path, MAP_SCHEMA, MAP_SCHEMA_VERSION, self.to_arrays())
+        return write_map_file(path, self.to_arrays())
 
     def to_arrays(self, with_colors: bool = True) -> dict[str, np.ndarray]:
         """Config, map and (unless ``with_colors=False``) colour classes as plain arrays.
@@ -856,20 +678,15 @@ class VisualCompass:
         """
         if self._colors is None:
             raise NotLearnedError("nothing to save: the compass has no colour classes yet")
-        arrays = {
-            "config": json_array(self.config.to_dict()),
-            "counts": self._counts.astype(np.uint32),
-            "sector_observations": self._n_obs.astype(np.uint32),
-            "frames_learned": np.array(self._frames, dtype=np.int64),
-            "exposure_reference": np.array(self._exposure_ref, dtype=np.float64),
-            "learned_sizes": np.array(sorted(self._sizes), dtype=np.int64).reshape(-1, 2),
-        }
-        if self.config.exposure == "map":
-            arrays["light_sum"] = self._light.level_sum.copy()
-            arrays["light_columns"] = self._light.columns.copy()
-        if with_colors:
-            arrays.update(self._colors.to_arrays())
-        return arrays
+        contents = MapContents(
+            counts=self._counts,
+            sector_observations=self._n_obs,
+            frames_learned=self._frames,
+            exposure_reference=self._exposure_ref,
+            learned_sizes=self._sizes,
+            light=self._light,
+        )
+        return map_arrays(self.config, contents, self._colors if with_colors else None)
 
     @classmethod
     def load(cls, path: str | os.PathLike, config: CompassConfig | None = None) -> VisualCompass:
@@ -889,8 +706,7 @@ class VisualCompass:
             Missing, empty, truncated or corrupt file, another schema or version,
             or arrays whose shapes do not match the stored config.
         """
-        arrays = load_npz_checked(path, MAP_SCHEMA, MAP_SCHEMA_VERSION)
-        return cls.from_arrays(arrays, path, config)
+        return cls.from_arrays(read_map_file(path), path, config)
 
     @classmethod
     def from_arrays(
@@ -918,84 +734,16 @@ class VisualCompass:
         MapFileError
             Naming ``source`` and the entry at fault.
         """
-        path = source
-        raw = read_json_array(arrays, "config", path)
-        try:
-            stored = CompassConfig.from_dict(raw)  # type: ignore[arg-type]
-        except (TypeError, ValueError) as e:
-            raise MapFileError(f"{path}: invalid config ({e})") from None
-        if config is not None and stored != config:
-            raise MapFileError(f"{path}: was learned with {stored}, expected {config}")
-        if colors is None:
-            try:
-                colors = ColorClasses.from_arrays(arrays)
-            except ValueError as e:
-                raise MapFileError(f"{path}: invalid colour classes ({e})") from None
+        stored, colors = read_config_and_colors(arrays, source, config, colors)
         vc = cls(stored, colors)
-        expect = {
-            "counts": vc._counts.shape,
-            "sector_observations": vc._n_obs.shape,
-            "frames_learned": (),
-        }
-        for key, shape in expect.items():
-            if key not in arrays:
-                raise MapFileError(f"{path}: missing entry {key!r}")
-            a = arrays[key]
-            if a.shape != shape or a.dtype.kind not in "iu":
-                raise MapFileError(
-                    f"{path}: entry {key!r} has shape {a.shape} and dtype {a.dtype}, "
-                    f"expected integer counts of shape {shape} for {stored}"
-                )
-        # checked as stored and copied straight into the compass' float64 map: a
-        # float64 copy of its own would add 8 bytes per count to the peak of loading
-        counts = arrays["counts"]
-        n_obs = arrays["sector_observations"].astype(np.float64)
-        if np.any(counts < 0) or np.any(n_obs < 0):
-            raise MapFileError(f"{path}: negative counts")
-        # every class pair of a sector gets exactly one count per frame that saw it
-        per_pair = counts.sum(axis=2, dtype=np.float64)
-        if not np.array_equal(per_pair, np.broadcast_to(n_obs[:, None], per_pair.shape)):
-            raise MapFileError(f"{path}: counts do not add up to the sector observations")
-        frames = int(arrays["frames_learned"])
-        if frames < 0 or (frames == 0) != (n_obs.sum() == 0):
-            raise MapFileError(f"{path}: frames_learned={frames} contradicts the counts")
-        ref = arrays.get("exposure_reference")
-        if (
-            ref is None
-            or ref.shape != ()
-            or ref.dtype.kind not in "iuf"
-            or not np.isfinite(ref)
-            or not 0 <= ref <= MAX_LIGHT_LEVEL
-        ):
-            # a mean linear light level: 0 (not fitted with exposure) to 1 (white)
-            raise MapFileError(
-                f"{path}: entry 'exposure_reference' missing or not a light level in [0, 1]"
-            )
-        if stored.exposure in REFERENCE_EXPOSURES and ref <= 0:
-            raise MapFileError(
-                f"{path}: exposure={stored.exposure!r} but no reference level stored"
-            )
-        vc._exposure_ref = float(ref)
-        sizes = arrays.get("learned_sizes")
-        if (
-            sizes is None
-            or sizes.ndim != 2
-            or sizes.shape[1] != 2
-            or sizes.dtype.kind not in "iu"
-            or np.any(sizes < 1)
-        ):
-            raise MapFileError(f"{path}: entry 'learned_sizes' missing or not an (N, 2) int array")
-        if sizes.shape[0] > MAX_LEARNED_SIZES:
-            raise MapFileError(
-                f"{path}: entry 'learned_sizes' lists {sizes.shape[0]} frame sizes, more than "
-                f"{MAX_LEARNED_SIZES}"
-            )
-        if stored.exposure == "map":
-            _read_light(vc._light, arrays, path)
-        vc._counts[:] = counts
-        vc._n_obs[:] = n_obs
-        vc._frames = frames
-        vc._sizes = {(int(a), int(b)) for a, b in sizes}
+        contents = read_map_contents(arrays, source, stored)
+        vc._exposure_ref = contents.exposure_reference
+        if contents.light is not None:
+            vc._light = contents.light
+        vc._counts[:] = contents.counts
+        vc._n_obs[:] = contents.sector_observations
+        vc._frames = contents.frames_learned
+        vc._sizes = contents.learned_sizes
         return vc
 
     def __repr__(self) -> str:
@@ -1005,196 +753,28 @@ class VisualCompass:
         )
 
 
-def _log_likelihoods_of(
-    config: CompassConfig,
-    geom: _Geometry,
-    counts: np.ndarray,
-    total: np.ndarray,
-    delta_t: np.ndarray,
-    base: np.ndarray,
-    maps: np.ndarray | None = None,
-) -> np.ndarray:
-    """Log-likelihood over headings (eq. 5, 15-16) of one frame under several maps.
-
-    The maps share ``config`` and colour classes, so the frame's sector features
-    (``geom``, ``counts``, ``total``) and which table rows they read are computed once;
-    ``delta_t`` ``(c²·n, M, S)`` and ``base`` ``(M, S)`` are the maps' stacked log
-    tables (:meth:`VisualCompass._log_tables`; rows first, so that one read brings a
-    row of every map). Sums run in the same order for any ``M``, so each map's row
-    equals its own :meth:`VisualCompass.log_likelihood` bit for bit. ``maps`` (indices
-    into ``M``) scores only those maps, reading only their tables. Returns
-    ``(M, n_headings)`` (``(len(maps), n_headings)``); all zeros where nothing was seen.
-    """
-    m = base.shape[0] if maps is None else len(maps)
-    per_group = _group_scores(config, geom, counts, total, delta_t, base, maps)
-    if per_group is None:
-        return np.zeros((m, geom.heading_phase.size))
-    # score[p, m, s0] = sum_k per_group[p, k, m, s0 + k + kmin]; the advanced indices
-    # come first: (K, S, P, M), summed over K
-    by_start = per_group[:, np.arange(geom.n_rel)[:, None], :, geom.roll_index].sum(axis=0)
-    return _by_heading(config, geom, by_start)
-
-
-def _by_heading(config: CompassConfig, geom: _Geometry, by_start: np.ndarray) -> np.ndarray:
-    """``(X, n_headings)`` log-likelihoods from the scores ``by_start[s0, p, x]`` of
-    every starting sector and phase (``X`` maps, or re-indexings of one map)."""
-    ll = by_start[geom.heading_sector, geom.heading_phase].T
-    if config.temperature != 1.0:
-        ll = ll / config.temperature
-    return np.ascontiguousarray(ll)
-
-
-def _group_scores(
-    config: CompassConfig,
-    geom: _Geometry,
-    counts: np.ndarray,
-    total: np.ndarray,
-    delta_t: np.ndarray,
-    base: np.ndarray,
-    maps: np.ndarray | None = None,
-) -> np.ndarray | None:
-    """``(P, K, M, S)``: the log-ratio of the frame's columns of phase ``p`` and relative
-    sector ``k`` under sector ``s`` of map ``m`` (see :func:`_log_likelihoods_of`);
-    ``None`` if the frame saw nothing."""
-    if maps is not None:
-        base = base[maps]
-    m = base.shape[0]
-    n = config.n_bins
-    seen = total > 0
-    if not seen.any():
-        return None
-    nz_group, nz_code = np.nonzero(counts)
-    z = counts[nz_group, nz_code] / total[nz_group]
-    rows = nz_code * n + log2_bin(z, n)
-    per_group = _group_sums(delta_t, rows, nz_group, counts.shape[0], maps)
-    per_group[seen] += base[None, :, :]
-    return per_group.reshape(-1, geom.n_rel, m, config.n_sectors)
-
-
-def _group_sums(
-    delta_t: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
-    n_groups: int,
-    maps: np.ndarray | None,
-) -> np.ndarray:
-    """``out[g, m, s] = Σ delta_t[rows[e], maps[m], s]`` over the entries ``e`` of group
-    ``g`` (``groups`` sorted, as :func:`numpy.nonzero` gives them); ``(n_groups, M, S)``.
-
-    The rows are gathered a few whole groups at a time (:data:`_GATHER_BYTES`), so the
-    gathered block stays in the cache. Each group is still one ``reduceat`` segment
-    summed in order, so the sums are bit for bit those of a single gather, for any
-    number of maps.
-    """
-    m = delta_t.shape[1] if maps is None else maps.size
-    out = np.zeros((n_groups, m, delta_t.shape[2]))
-    if rows.size == 0:
-        return out
-    starts = np.flatnonzero(np.r_[True, groups[1:] != groups[:-1]])
-    bounds = np.r_[starts, rows.size]
-    per_chunk = max(1, _GATHER_BYTES // (m * delta_t.shape[2] * delta_t.itemsize))
-    i = 0
-    while i < starts.size:
-        # the groups that fit in per_chunk rows, at least one
-        j = int(np.searchsorted(bounds, bounds[i] + per_chunk, side="right")) - 1
-        j = min(max(j, i + 1), starts.size)
-        a, b = bounds[i], bounds[j]
-        if maps is None:
-            gathered = np.take(delta_t, rows[a:b], axis=0)  # (E, M, S)
-        else:
-            gathered = delta_t[rows[a:b, None], maps[None, :]]
-        out[groups[starts[i:j]]] = np.add.reduceat(gathered, starts[i:j] - a, axis=0)
-        i = j
-    return out
-
-
 def _estimates_of(
     compasses: Sequence[VisualCompass],
-    geom: _Geometry,
+    geom: ScanGeometry,
     counts: np.ndarray,
     total: np.ndarray,
     lls: np.ndarray,
 ) -> list[CompassEstimate]:
     """:class:`CompassEstimate` of one frame under each map, from its log-likelihoods.
 
-    ``lls`` is ``(M, n_headings)`` (:func:`_log_likelihoods_of`). The best heading is
-    refined by a parabola through the peak and its neighbours, the spread is the
-    circular standard deviation of the posterior (eq. 27) and the score the mean
-    per-term log-probability at the best heading (eq. 28), all computed for the ``M``
-    maps at once.
+    ``lls`` is ``(M, n_headings)`` (:func:`~vc_gym.compass.likelihood.log_likelihoods`);
+    the numbers are those of :func:`~vc_gym.compass.likelihood.heading_estimates`,
+    computed for the ``M`` maps at once.
     """
     first = compasses[0]
-    headings = first._headings
-    m = lls.shape[0]
-    heading, best = peak_headings(lls, first.config.heading_step_deg)
-    spread = circular_std_rows(headings, np.exp(lls - lls[np.arange(m), best][:, None]))
-    scores, n_sectors = _scores_at(compasses, geom, counts, total, best)
+    log_abs = [vc._log_tables()[2] for vc in compasses]
+    heading, spread, scores, n_sectors = heading_estimates(
+        first.config, first._headings, log_abs, geom, counts, total, lls
+    )
     return [
         CompassEstimate(float(heading[k]), float(spread[k]), scores[k], n_sectors[k], lls[k])
-        for k in range(m)
+        for k in range(lls.shape[0])
     ]
-
-
-def _scores_at(
-    compasses: Sequence[VisualCompass],
-    geom: _Geometry,
-    counts: np.ndarray,
-    total: np.ndarray,
-    best: np.ndarray,
-) -> tuple[list[float], list[int]]:
-    """Each map's goodness at its own best heading: the mean per-term log-probability
-    of the frame's features (eq. 28) and the number of sectors used; the frame's bins
-    are read once per heading phase."""
-    cfg = compasses[0].config
-    k_rel = geom.n_rel
-    scores, used = [0.0] * len(compasses), [0] * len(compasses)
-    phases = geom.heading_phase[best]
-    for p in np.unique(phases):
-        t = total[p * k_rel : (p + 1) * k_rel]
-        seen = np.flatnonzero(t > 0)
-        if seen.size == 0:
-            continue
-        c = counts[p * k_rel : (p + 1) * k_rel]
-        bins = log2_bin(c[seen] / t[seen, None], cfg.n_bins)  # (seen, c2)
-        pairs = np.arange(c.shape[1])[None, :]
-        for k in np.flatnonzero(phases == p):
-            log_abs = compasses[k]._log_tables()[2]
-            sectors = (geom.heading_sector[best[k]] + seen + geom.kmin) % cfg.n_sectors
-            scores[k] = float(log_abs[sectors[:, None], pairs, bins].mean())
-            used[k] = int(seen.size)
-    return scores, used
-
-
-def _read_light(light: LightMap, arrays: Mapping[str, np.ndarray], path: object) -> None:
-    """Fill ``light`` from a map file's ``light_sum`` and ``light_columns``, checked."""
-    shape = light.level_sum.shape
-    read = []
-    for key in ("light_sum", "light_columns"):
-        a = arrays.get(key)
-        if a is None or a.shape != shape or a.dtype.kind not in "iuf":
-            raise MapFileError(
-                f"{path}: exposure='map' needs entry {key!r}: a number per sector, shape {shape}"
-            )
-        a = a.astype(np.float64)
-        if not np.all(np.isfinite(a)) or np.any(a < 0):
-            raise MapFileError(f"{path}: entry {key!r} must be finite and >= 0")
-        read.append(a)
-    level_sum, columns = read
-    # every column's mean level is at most 1 (linear light)
-    if np.any(level_sum > columns * (1 + 1e-9)):
-        raise MapFileError(f"{path}: light_sum exceeds light_columns (levels above 1)")
-    light.level_sum[:] = level_sum
-    light.columns[:] = columns
-
-
-def _check_sizes(sizes: set[tuple[int, int]]) -> None:
-    """A ``ValueError`` if a map would remember more than :data:`MAX_LEARNED_SIZES`
-    frame sizes (the loader refuses such a file)."""
-    if len(sizes) > MAX_LEARNED_SIZES:
-        raise ValueError(
-            f"a map learns frames of at most {MAX_LEARNED_SIZES} different sizes; this one "
-            f"would have {len(sizes)}"
-        )
 
 
 def _same_colors(a: ColorClasses, b: ColorClasses) -> bool:

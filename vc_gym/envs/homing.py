@@ -151,8 +151,8 @@ class StopAction(gym.Wrapper):
     to count as moving for the task (``|forward|``, ``|turn|`` ≤ its ``still_threshold``)
     turns at the slowest rate that does count, towards ``a[1]``'s sign. Without this, a
     policy whose walk outputs hover near zero would stand still for the task's
-    ``stop_time_s`` and end the episode by accident (11 % of early PPO episodes ended so
-    within three decisions).
+    ``stop_time_s`` and end the episode by accident, which an untrained policy does often
+    within its first few decisions.
 
     A decision that does not walk forward (turning in place, or standing while a stop is
     held) scans with the head, the next pan of ``HEAD_SCAN_DEG`` at each step, as the

@@ -502,7 +502,7 @@ class GridLearning:
     then holds how the view changes within ``around_m`` of its spot, so it still fits,
     with the right heading, a robot that stands between spots: over the robolab field
     the heading error from the best-fitting map fell by about a third with 0.5 m
-    (``vc-gym experiment orientation --modes improved``).
+    (``vc-gym experiment orientation --modes spot-grid``).
 
     Parameters
     ----------

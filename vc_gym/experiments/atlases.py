@@ -25,7 +25,8 @@ from vc_gym.compass import CompassAtlas, CompassConfig
 from vc_gym.envs.atlas_file import SavedAtlas
 from vc_gym.envs.learning import GridLearning, LearningConfig, SpotLearning
 from vc_gym.errors import MapFileError
-from vc_gym.jobs.runner import ExperimentRun, Job
+from vc_gym.jobs.job import Job
+from vc_gym.jobs.run import ExperimentRun
 from vc_gym.persistence import write_atomic
 
 __all__ = ["SavedAtlas", "atlas_key", "atlas_spec", "ensure_atlases", "learn_atlas_job"]

@@ -40,12 +40,15 @@ from vc_gym.experiments.check_case import Case, raises
 from vc_gym.experiments.check_security import model_with_data, security_cases
 from vc_gym.filters import KalmanHeadingFilter, ParticleFilter, TranslationalFilter
 from vc_gym.heading_sensors import load_sensor, make_sensor
-from vc_gym.jobs.runner import ExperimentRun, Job, LocalBackend
+from vc_gym.jobs.backends import LocalBackend
+from vc_gym.jobs.job import Job
+from vc_gym.jobs.run import ExperimentRun
 from vc_gym.localization import make_tracker
 from vc_gym.persistence import load_npz_checked, save_npz_atomic
+from vc_gym.training.config import TrainConfig
 from vc_gym.training.safe_load import UnsafeModelError, load_sb3_model
-from vc_gym.training.train import TrainConfig
-from vc_gym.worlds.panorama import make_panorama, render_view
+from vc_gym.worlds.panorama import render_view
+from vc_gym.worlds.panorama_painters import make_panorama
 
 __all__ = ["Case", "all_cases", "run_check"]
 

@@ -27,8 +27,8 @@ import numpy as np
 from vc_gym.agents.learned import PRETRAINED_MODEL, LearnedHomingAgent
 from vc_gym.config_files import read_settings
 from vc_gym.experiments.check_case import Case, raises
+from vc_gym.training.config import read_train_config
 from vc_gym.training.safe_load import UnsafeModelError, load_sb3_model
-from vc_gym.training.train import read_train_config
 
 __all__ = ["alias_bomb", "model_with_data", "security_cases"]
 
@@ -306,7 +306,8 @@ def _existing_run_kept(tmp: Path) -> None:
 
 
 def _torn_checkpoint_skipped(tmp: Path) -> None:
-    from vc_gym.training.train import read_train_config, resume_state
+    from vc_gym.training.config import read_train_config
+    from vc_gym.training.run_folder import resume_state
 
     run = tmp / "run"
     shutil.copytree(PRETRAINED_MODEL.parent, run)
@@ -383,7 +384,7 @@ def _interrupted(tmp: Path) -> None:
 
 
 def _tracker_json(_: Path) -> None:
-    from vc_gym.training.train import TrainConfig, check_names
+    from vc_gym.training.config import TrainConfig, check_names
 
     config = TrainConfig(tracker={"type": "particle", "n_particles": 500})
     check_names(config)

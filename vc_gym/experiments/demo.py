@@ -17,8 +17,10 @@ import numpy as np
 
 from vc_gym.envs.learning import LearningResult, ScriptedLearning
 from vc_gym.experiments.episode import (
+    DEFAULT_HOMING_MODE,
     HOMING_MODES,
     EpisodeRecord,
+    canonical_homing_mode,
     make_homing_run,
     run_episode,
 )
@@ -46,7 +48,7 @@ def run_demo(
     tracker: TrackerSpec = "grid",
     max_homing_s: float = 60.0,
     progress: bool = True,
-    mode: str = "improved",
+    mode: str = DEFAULT_HOMING_MODE,
 ) -> dict[str, object]:
     """Run one scripted learn-then-home episode in the robolab and save the results.
 
@@ -75,9 +77,9 @@ def run_demo(
         Progress bars per phase.
     mode : str
         How the place is learned and the robot homes
-        (:data:`~vc_gym.experiments.episode.HOMING_MODES`): ``"improved"`` (default; over
-        learning seeds 0-8 it homes better than the paper's procedure, see README) or
-        ``"paper"``.
+        (:data:`~vc_gym.experiments.episode.HOMING_MODES`): ``"check-home"`` (default:
+        normalised at the true home, home checked with a full turn before stopping) or
+        ``"paper"`` (the paper's procedure).
 
     Returns
     -------
@@ -90,6 +92,7 @@ def run_demo(
         For any argument out of range, before the folder is made or anything is run.
     """
     check_demo_args(seed, learn_time_s, success_radius_m, tracker, max_homing_s, progress, mode)
+    mode = canonical_homing_mode(mode)
     with new_out_dir(out_dir) as out:
         t0 = time.perf_counter()
         run = make_homing_run(
@@ -131,7 +134,7 @@ def check_demo_args(
     tracker: TrackerSpec = "grid",
     max_homing_s: object = 60.0,
     progress: object = True,
-    mode: object = "improved",
+    mode: object = DEFAULT_HOMING_MODE,
     names: dict[str, str] | None = None,
 ) -> None:
     """Check :func:`run_demo`'s arguments before anything is made or run.
@@ -159,8 +162,12 @@ def check_demo_args(
     positive_float(name("success_radius_m"), success_radius_m)
     positive_float_at_most(name("max_homing_s"), max_homing_s, MAX_HOMING_S)
     flag(name("progress"), progress)
-    if not isinstance(mode, str) or mode not in HOMING_MODES:
-        raise ValueError(f"{name('mode')} must be one of {list(HOMING_MODES)}, got {mode!r}")
+    try:
+        canonical_homing_mode(mode)
+    except ValueError:
+        raise ValueError(
+            f"{name('mode')} must be one of {list(HOMING_MODES)}, got {mode!r}"
+        ) from None
     make_tracker(tracker)
 
 

@@ -13,6 +13,7 @@ is one) without changing what is recorded.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -22,19 +23,24 @@ import numpy as np
 from tqdm import tqdm
 
 from vc_gym.agents.learned import LearnedHomingAgent
-from vc_gym.agents.scripted import ScriptedHomingPolicy
+from vc_gym.agents.scripted import ScriptedHomingAgent
 from vc_gym.angles import wrap180
 from vc_gym.envs.homing import LEARNED_CONFIRM_STOP_M
 from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
 
 __all__ = [
+    "DEFAULT_HOMING_MODE",
     "HOMING_MODES",
+    "canonical_homing_mode",
     "LEARNED_CONFIRM_STOP_M",
     "EpisodeRecord",
     "HomingMode",
     "EpisodeStep",
     "HomingRun",
+    "check_agent_env",
+    "load_agent",
+    "make_agent_env",
     "make_homing_run",
     "homing_mode",
     "run_episode",
@@ -174,20 +180,41 @@ class HomingMode:
 #: The homing modes. ``paper``: the paper's procedure (5.2), normalising the spots
 #: after walking back home by odometry, whose drift (15-20 cm in the simulated robolab)
 #: becomes the stops' systematic offset, and stopping wherever the estimate says home.
-#: ``improved``: normalising with every frame of the first turn, taken at the true home
-#: before the robot moved, and checking with a full turn that the place is home before
-#: stopping (``verify_home``; a single view can alias with home 1-2 m away).
+#: ``check-home`` (the default): normalising with every frame of the first turn, taken at
+#: the true home before the robot moved, and checking with a full turn that the place is
+#: home before stopping (``verify_home``; a single view can alias with home 1-2 m away).
 HOMING_MODES: dict[str, HomingMode] = {
     "paper": HomingMode(learning={}, policy={}),
-    "improved": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
+    "check-home": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
 }
+#: The homing mode of the demo, ``vc-gym evaluate`` and every experiment unless told.
+DEFAULT_HOMING_MODE = "check-home"
+#: Deprecated names of homing modes, accepted with a ``DeprecationWarning``.
+DEPRECATED_HOMING_MODES = {"improved": "check-home"}
+
+
+def canonical_homing_mode(mode: object) -> str:
+    """The name of homing mode ``mode`` (a deprecated name warns and gives the new one).
+
+    Raises
+    ------
+    ValueError
+        Naming the modes, for anything else.
+    """
+    if isinstance(mode, str) and mode in DEPRECATED_HOMING_MODES:
+        new = DEPRECATED_HOMING_MODES[mode]
+        warnings.warn(
+            f"homing mode {mode!r} is deprecated; use {new!r}", DeprecationWarning, stacklevel=3
+        )
+        return new
+    if not isinstance(mode, str) or mode not in HOMING_MODES:
+        raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
+    return mode
 
 
 def homing_mode(mode: str) -> HomingMode:
     """The :class:`HomingMode` called ``mode``, or a ``ValueError`` naming the modes."""
-    if not isinstance(mode, str) or mode not in HOMING_MODES:
-        raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
-    return HOMING_MODES[mode]
+    return HOMING_MODES[canonical_homing_mode(mode)]
 
 
 def make_homing_run(
@@ -200,7 +227,7 @@ def make_homing_run(
     max_homing_s: float = 60.0,
     learner: Callable | None = None,
     keep_image: bool = False,
-    mode: str = "paper",
+    mode: str = DEFAULT_HOMING_MODE,
     policy: dict[str, Any] | None = None,
     allow_imports: bool = False,
 ) -> HomingRun:
@@ -228,7 +255,7 @@ def make_homing_run(
         env instead, see :class:`~vc_gym.experiments.video.EpisodeVideo`).
     mode : str
         How the place is learned and how the scripted agent homes
-        (:data:`HOMING_MODES`): ``"paper"`` or ``"improved"``. With a saved atlas
+        (:data:`HOMING_MODES`): ``"check-home"`` (default) or ``"paper"``. With a saved atlas
         (``learner``) only the policy part applies; the atlas brings its own learning.
     policy : dict, optional
         More keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`,
@@ -250,14 +277,72 @@ def make_homing_run(
     }
     if learner is not None:
         task["learner"] = learner
+    chosen_agent = load_agent(agent, allow_imports, policy=policy_kwargs)
+    env = make_agent_env(chosen_agent, tracker=tracker, keep_image=keep_image, **task)
+    acting = chosen_agent.policy(env)
+    return HomingRun(env, acting.predict, acting.reset)
+
+
+#: What :func:`load_agent` returns: an agent that names its env and gives a policy for it.
+HomingAgent = ScriptedHomingAgent | LearnedHomingAgent
+
+
+def load_agent(
+    agent: str, allow_imports: bool = False, policy: dict[str, Any] | None = None
+) -> HomingAgent:
+    """The agent named ``agent``: ``"scripted"`` or the path of a learned ``model.zip``.
+
+    Parameters
+    ----------
+    agent : str
+        ``"scripted"`` or a ``model.zip`` written by ``vc-gym train``.
+    allow_imports : bool
+        Let a learned agent's ``config.json`` name its tracker by import path.
+    policy : dict, optional
+        Keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy` (scripted only).
+    """
     if agent == "scripted":
-        env = gym.make("vc_gym/LearnThenHome-v0", **task)
-        env = CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
-        scripted = ScriptedHomingPolicy.for_env(env, **policy_kwargs)
-        return HomingRun(env, scripted.predict, scripted.reset)
-    learned = LearnedHomingAgent(agent, allow_imports)
-    env = learned.make_env(tracker=tracker, confirm_stop_m=LEARNED_CONFIRM_STOP_M, **task)
-    return HomingRun(env, learned.predict, None)
+        return ScriptedHomingAgent(**(policy or {}))
+    return LearnedHomingAgent(agent, allow_imports)
+
+
+def make_agent_env(
+    agent: HomingAgent, tracker: TrackerSpec = "grid", keep_image: bool = False, **task: Any
+) -> gym.Env:
+    """The env ``agent`` acts in: its ``env_id`` with its own settings, then ``task``'s.
+
+    An agent observing ``"compass"`` sees the task through
+    :class:`~vc_gym.envs.CompassObservation` with ``tracker`` (``keep_image`` keeps the
+    frame, for a video); one observing ``"features"`` gets ``vc_gym/Homing-v0``, whose
+    ``tracker`` is an env argument and whose stops are checked while it stands
+    (:data:`LEARNED_CONFIRM_STOP_M`).
+    """
+    if agent.observation == "compass":
+        env = gym.make(agent.env_id, **{**agent.env_kwargs, **task})
+        return CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
+    own = {"tracker": tracker, "confirm_stop_m": LEARNED_CONFIRM_STOP_M}
+    return gym.make(agent.env_id, **{**agent.env_kwargs, **own, **task})
+
+
+def check_agent_env(agent: HomingAgent, source: str) -> None:
+    """Build (and close) ``agent``'s env with its own settings once, so that settings the
+    env refuses (an unknown key, scene or value) fail here, naming ``source``, not later
+    in every worker.
+
+    Raises
+    ------
+    ValueError
+        Naming ``source`` and what the env said.
+    """
+    try:
+        env = gym.make(agent.env_id, **agent.env_kwargs)
+    except Exception as exc:  # noqa: BLE001 - TypeError (a key), ValueError (a value)
+        cause = exc.__cause__ or exc
+        raise ValueError(
+            f"{source}: its env arguments are refused by {agent.env_id}: "
+            f"{type(cause).__name__}: {str(cause).split(' was raised from')[0]}"
+        ) from None
+    env.close()
 
 
 def _tracker_counters(env: gym.Env) -> tuple[float, int]:

@@ -20,11 +20,25 @@ import numpy as np
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassConfig, ImageCompass, VisualCompass
-from vc_gym.experiments.real_data import ROTATION_SETS, RotationPhoto, load_rotation_set
+from vc_gym.experiments.real_data import (
+    ROTATION_SETS,
+    RotationPhoto,
+    default_real_data_dir,
+    load_rotation_set,
+)
+from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.exposure import SessionLight, gain_table
+from vc_gym.jobs.output import write_json
 from vc_gym.validation import positive_float
 
-__all__ = ["crop_columns", "evaluate_rotation_set", "rotation_set_errors", "run_real_rotation"]
+__all__ = [
+    "crop_columns",
+    "evaluate_rotation_set",
+    "evaluate_rotation_sets",
+    "rotation_set_errors",
+    "run_real_rotation",
+    "summary_lines",
+]
 
 #: Exposure modes whose crops are also estimated at the light of the whole set.
 SESSION_EXPOSURES = ("map", "session")
@@ -216,7 +230,7 @@ def evaluate_rotation_set(
     return out
 
 
-def run_real_rotation(
+def evaluate_rotation_sets(
     data_dir: str | os.PathLike,
     n_colors: tuple[int, ...] = (10, 3),
     exposures: tuple[str, ...] = ("none", "mean", "map", "session"),
@@ -244,3 +258,56 @@ def run_real_rotation(
         r = evaluate_rotation_set(loaded[set_name], cfg, light=light)
         results.append({"set": set_name, "n_colors": c, "exposure": exposure, "light": light, **r})
     return {"experiment": "real_rotation", "results": results}
+
+
+def run_real_rotation(
+    out_dir: str | os.PathLike,
+    opts: ExperimentOptions | None = None,
+    data_dir: str | os.PathLike | None = None,
+) -> dict[str, object]:
+    """The ``real-rotation`` experiment: :func:`evaluate_rotation_sets` on the photos in
+    ``data_dir``, written to ``out_dir/results.json``.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        Output folder.
+    opts : ExperimentOptions, optional
+        Only ``progress`` is used (the experiment draws nothing at random).
+    data_dir : path-like, optional
+        The folder holding ``rotation_grail/`` and ``rotation_parrington/``; default
+        :func:`~vc_gym.experiments.real_data.default_real_data_dir`.
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no such folder.
+    """
+    opts = opts or ExperimentOptions()
+    data = Path(data_dir) if data_dir is not None else default_real_data_dir()
+    if data is None or not data.is_dir():
+        raise FileNotFoundError(
+            "real photos not found: pass --data DIR (the folder holding rotation_grail/ "
+            "and rotation_parrington/) or set VC_GYM_REAL_DATA"
+        )
+    result = evaluate_rotation_sets(data, progress=opts.progress)
+    write_json(Path(out_dir) / "results.json", result)
+    return result
+
+
+def summary_lines(results: dict) -> list[str]:
+    """A table: set, light, colour classes, exposure, median error, share within 5°."""
+    head = f"{'set':22s} {'light':>5s} {'classes':>7s} {'exposure':>8s} {'median':>8s} {'<5°':>5s}"
+    lines = [head]
+    for r in results["results"]:
+        line = (
+            f"{r['set']:22s} {r['light']:5.2f} {r['n_colors']:7d} {r['exposure']:>8s} "
+            f"{r['median_error_deg']:7.2f}° {r['within_5deg']:5.0%}"
+        )
+        if "session_gain" in r:
+            line += (
+                f"  (session gain {r['session_gain']:.2f}; per frame "
+                f"{r['per_frame_median_error_deg']:.2f}°, {r['per_frame_within_5deg']:.0%})"
+            )
+        lines.append(line)
+    return lines

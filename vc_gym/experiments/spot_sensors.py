@@ -11,7 +11,7 @@ import numpy as np
 from vc_gym.compass import Camera, VisualCompass
 from vc_gym.experiments.views import learning_turn
 from vc_gym.heading_sensors import make_sensor
-from vc_gym.jobs.runner import worker_cache
+from vc_gym.jobs.workers import worker_cache
 from vc_gym.sim.aibo_room import AiboRoomEnv
 
 __all__ = ["fit_colours", "room", "spot_sensor_job", "teach"]

@@ -20,11 +20,13 @@ from tqdm import tqdm
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
+from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.exposure import SessionLight
 from vc_gym.jobs.output import new_figure, save_figure, write_json
-from vc_gym.worlds.panorama import Panorama, make_panorama, render_view
+from vc_gym.worlds.panorama import Panorama, render_view
+from vc_gym.worlds.panorama_painters import make_panorama
 
-__all__ = ["run_synthetic_compass"]
+__all__ = ["run_synthetic_compass", "summary_lines"]
 
 HEAD_PANS_DEG = (-22.5, 0.0, 22.5)
 BODY_YAWS_DEG = tuple(range(0, 360, 45))
@@ -60,12 +62,28 @@ def _evaluate(
 
 
 def run_synthetic_compass(
-    out_dir: str | os.PathLike = "vc_gym_synthetic", seed: int = 0, n_test: int = 120
+    out_dir: str | os.PathLike = "vc_gym_synthetic",
+    opts: ExperimentOptions | None = None,
+    n_test: int = 120,
 ) -> dict:
-    """Run the experiment; write ``results.json`` and ``.png`` to ``out_dir``.
+    """Run the experiment; write ``results.json`` and ``synthetic_compass.png`` to
+    ``out_dir``.
 
-    Returns the summary dict (what ``results.json`` holds: figures only).
+    Parameters
+    ----------
+    out_dir : path-like
+        Output folder.
+    opts : ExperimentOptions, optional
+        Only ``seed`` is used (the panoramas and the test yaws derive from it).
+    n_test : int
+        Test frames per panorama, exposure and light.
+
+    Returns
+    -------
+    dict
+        What ``results.json`` holds (figures only).
     """
+    seed = (opts or ExperimentOptions()).seed
     if n_test < 1:
         raise ValueError(f"n_test must be >= 1, got {n_test}")
     out = Path(out_dir)
@@ -164,3 +182,17 @@ def _plot(path: Path, panos: dict, curves: dict, example: tuple) -> None:
     ax.set_ylabel("median |error| (deg)")
     ax.set_title("median error")
     save_figure(fig, path, dpi=100)
+
+
+def summary_lines(results: dict) -> list[str]:
+    """One line per panorama and exposure: median error and share within 5° per light."""
+    lines = []
+    for label, entry in results["results"].items():
+        parts = [
+            f"light×{k.split('_')[1]}: median {v['median_error_deg']:.2f}°, "
+            f"{v['within_5deg']:.0%} within 5°"
+            + (f" (session gain {v['session_gain']:.2f})" if "session_gain" in v else "")
+            for k, v in entry.items()
+        ]
+        lines.append(f"{label:28s} " + " | ".join(parts))
+    return lines

@@ -21,6 +21,14 @@ maps a frame.
 :func:`make_tracker` builds one from a name, a ``{"type": name, **kwargs}`` dict or a
 callable; :func:`register_tracker` adds a name.
 
+Position over the whole field from maps on a grid of spots, beyond eq. 30 (which answers
+only inside the spots' hull), from the spots' score vectors (:func:`mean_spot_scores`):
+
+* :func:`locate_by_goodness` -- one view: a likelihood calibrated on goodness against
+  distance (:func:`calibrate_goodness` on frames at :func:`calibration_points`);
+* :func:`locate_by_turn_signature` -- a full turn: the calibration places whose
+  turn-averaged scores are nearest.
+
 >>> from vc_gym.localization import make_tracker          # doctest: +SKIP
 >>> tracker = make_tracker({"type": "particle", "n_particles": 2000})   # doctest: +SKIP
 >>> tracker.reset(atlas, camera, dt_s=0.1)                 # doctest: +SKIP
@@ -32,19 +40,29 @@ from vc_gym.localization.compass_sensors import (
     CompassHeadingSensor,
     best_spot_heading_log_likelihood,
 )
+from vc_gym.localization.goodness_calibration import (
+    GoodnessCalibration,
+    calibrate_goodness,
+    calibration_points,
+    goodness_log_likelihood,
+    locate_by_goodness,
+)
 from vc_gym.localization.grid_tracker import GridTracker
 from vc_gym.localization.kalman_tracker import KalmanTracker
 from vc_gym.localization.particle_tracker import ParticleTracker
 from vc_gym.localization.position import AtlasPositionFilter
 from vc_gym.localization.registry import TRACKERS, TrackerSpec, make_tracker, register_tracker
 from vc_gym.localization.shortlist import SpotShortlist
+from vc_gym.localization.spot_scores import mean_spot_scores
 from vc_gym.localization.tracker_protocol import Tracker, TrackerState
+from vc_gym.localization.turn_signature import locate_by_turn_signature
 
 __all__ = [
     "TRACKERS",
     "AtlasPoseSensor",
     "AtlasPositionFilter",
     "CompassHeadingSensor",
+    "GoodnessCalibration",
     "GridTracker",
     "KalmanTracker",
     "ParticleTracker",
@@ -53,6 +71,12 @@ __all__ = [
     "TrackerSpec",
     "TrackerState",
     "best_spot_heading_log_likelihood",
+    "calibrate_goodness",
+    "calibration_points",
+    "goodness_log_likelihood",
+    "locate_by_goodness",
+    "locate_by_turn_signature",
     "make_tracker",
+    "mean_spot_scores",
     "register_tracker",
 ]

@@ -1,8 +1,10 @@
 """Training homing policies with stable-baselines3 (``vc-gym train``).
 
 Shaped like SB3's algorithms over ``common/``: :func:`train` (:mod:`.train`) fits PPO or
-SAC on ``vc_gym/Homing-v0`` from a :class:`TrainConfig`, on shared parts:
+SAC on ``vc_gym/Homing-v0`` from a :class:`TrainConfig` (:mod:`.config`), on shared parts:
 
+* :mod:`.environments` -- the envs a run trains on, one per place;
+* :mod:`.run_folder` -- what a run's folder holds, its checkpoints, where a resume starts;
 * :mod:`.callbacks` -- atomic checkpoints and the training log;
 * :mod:`.async_rollouts` -- the collector that steps worker envs without lockstep;
 * :mod:`.imitation` and :mod:`.feature_expert` -- the scripted rule as an expert on

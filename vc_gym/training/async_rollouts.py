@@ -4,7 +4,7 @@ the policy.
 stable-baselines3 steps its ``SubprocVecEnv`` workers in lockstep: a step ends when the
 slowest worker's does. A homing decision is not a fixed amount of work (a checked stop
 stands for up to the task's 5 s, 50 steps of the task env), so in lockstep the other
-worker idles through every stand (README, "Training"). Here each worker is sent the
+worker idles through every stand. Here each worker is sent the
 policy's weights at the start of a rollout and takes its ``n_steps`` decisions on its
 own, choosing each action itself: no worker waits for another, nor for the parent
 process and a round trip through a pipe at every decision. The rollout waits for the

@@ -2,31 +2,28 @@
 
 In the paper's procedure the spots are normalised where the robot believes home is after
 walking back by odometry, a few centimetres off the true home, so the tracker's home lies
-off the true one, and by about the same amount on every learning seed (README, *Beyond
-the paper*: the robot stood at (+11, −12), (+12, −14) and (+14, −13) cm on seeds 0–2). An
-agent that stops where the tracker says home inherits it. A learned agent can do better
-because training, unlike homing, knows the true pose: before the warm start,
-:func:`measure_home_offset` lets the scripted expert home a few times in each of several
-places and takes, per axis, the median of ``estimate − true position`` where it stands
-at the end. ``vc-gym train --home-offset-episodes N`` then trains and evaluates on
+off the true one, by about the same amount on every learning seed. An agent that stops
+where the tracker says home inherits it. A learned agent can do better because training,
+unlike homing, knows the true pose: before the warm start, :func:`measure_home_offset`
+lets the scripted expert home a few times in each of several places and takes, per axis,
+the median of ``estimate − true position`` where it stands at the end. ``vc-gym train
+--home-offset-episodes N`` then trains and evaluates on
 ``vc_gym/Homing-v0(home_offset_m=that)``: the policy's home vector points to where the
-estimate read at the expert's stops would put the true home. Part of the offset belongs to the
-place (in training seed 0's four places the medians ranged from −14.9 to −2.6 cm in x and
-from +5.0 to +17.4 cm in y), so the measurement pools several places.
+estimate read at the expert's stops would put the true home. Part of the offset belongs
+to the place, so the measurement pools several places.
 
 It is not the estimate read at the true home itself: the agent decides to stop on its
-walking estimate, which is noisy (at the true home, ±30 cm), and the estimate after a
-stand there differs again (in training seed 0's places (−16, +16) cm after 5 s, against
-(−7, +10) cm at the stops). What matters is where the stops end up, and going to the
-corrected goal the stops can move further than the goal did (in training seed 1's places 1.2–1.5
-times as far, overshooting to the north-west). :func:`centre_home_offset` (``vc-gym
-train --home-offset-centre``) then lets the expert home again on the same kidnappings,
-going to the measured goal, and moves the goal so that its median stop lies at the true
-home (a secant step per axis).
+walking estimate, which is noisy, and the estimate after a stand there differs again.
+What matters is where the stops end up, and going to the corrected goal the stops can
+move further than the goal did. :func:`centre_home_offset` (``vc-gym train
+--home-offset-centre``) then lets the expert home again on the same kidnappings, going
+to the measured goal, and moves the goal so that its median stop lies at the true home
+(a secant step per axis).
 
-Neither is ``vc-gym train``'s default: on the learning seeds the default recipe was
-chosen on (10-12), policies trained towards the tracker's home stopped within 30 cm
-more often than those trained with either goal (README, *Learned agents*).
+``vc-gym train`` measures and centres the goal by default
+(:class:`~vc_gym.training.config.TrainConfig`: ``home_offset_episodes=10``,
+``home_offset_centre=True``); ``--home-offset-episodes 0 --no-home-offset-centre`` trains
+towards the tracker's home.
 """
 
 from __future__ import annotations

@@ -22,14 +22,12 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.jobs.runner import ExperimentRun, Job
+from vc_gym.jobs.job import Job
+from vc_gym.jobs.run import ExperimentRun
 from vc_gym.persistence import zip_entries_problem
-from vc_gym.training.train import (
-    TrainConfig,
-    continue_run,
-    read_train_config,
-    run_files,
-)
+from vc_gym.training.config import TrainConfig, read_train_config
+from vc_gym.training.run_folder import run_files
+from vc_gym.training.train import continue_run
 
 __all__ = ["FIGURES", "train_job", "run_train_sweep"]
 

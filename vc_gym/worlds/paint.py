@@ -1,10 +1,11 @@
 """Colour and noise helpers shared by every painter of vc_gym's worlds and textures.
 
-The procedural panoramas (:mod:`vc_gym.worlds.panorama`), the ray-cast room
-(:mod:`vc_gym.worlds.room`) and the PyBullet scene textures (:mod:`vc_gym.sim.textures`)
-all paint with these:
+The procedural panoramas (:mod:`vc_gym.worlds.panorama_painters`), the ray-cast room
+(:mod:`vc_gym.worlds.room`), the :class:`~vc_gym.worlds.canvas.Canvas` and the PyBullet
+scene textures (:mod:`vc_gym.sim.textures`) all paint with these:
 
 * :func:`hsv` and :func:`random_colour`: colours as ``(3,)`` ``float32`` RGB in 0..255;
+* :func:`to_uint8`: a painted float image as the ``uint8`` image everything else takes;
 * :func:`value_noise`: smooth value noise in ``[-1, 1]``, periodic along x (seamless
   around a panorama or a room's perimeter);
 * :func:`smooth_noise`: smooth Gaussian noise of about unit standard deviation, not
@@ -25,7 +26,7 @@ import colorsys
 import cv2
 import numpy as np
 
-__all__ = ["hsv", "random_colour", "smooth_noise", "smoothstep", "value_noise"]
+__all__ = ["hsv", "random_colour", "smooth_noise", "smoothstep", "to_uint8", "value_noise"]
 
 
 def hsv(h: float, s: float, v: float) -> np.ndarray:
@@ -70,6 +71,24 @@ def random_colour(
         ``(3,)`` ``float32`` RGB in 0..255.
     """
     return hsv(rng.uniform(*h), rng.uniform(*s), rng.uniform(*v))
+
+
+def to_uint8(img: np.ndarray) -> np.ndarray:
+    """A float image in 0..255 rounded to the nearest integer and clipped, as ``uint8``.
+
+    Parameters
+    ----------
+    img : numpy.ndarray
+        Float image (any shape), values nominally 0..255.
+
+    Returns
+    -------
+    numpy.ndarray
+        A new ``uint8`` array of the same shape; ``img`` is not changed.
+    """
+    out = np.rint(img)
+    np.clip(out, 0, 255, out=out)
+    return out.astype(np.uint8)
 
 
 def smoothstep(t: np.ndarray) -> np.ndarray:

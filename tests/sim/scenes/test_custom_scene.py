@@ -14,13 +14,14 @@ import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.sim import textures
 from vc_gym.sim.head_camera import HeadCameraSpec, render_camera
 from vc_gym.sim.scenes import (
+    Builder,
+    Room,
     SceneLayout,
     build_scene,
     register_scene,
     scene_names,
     unregister_scene,
 )
-from vc_gym.sim.scenes.base import Builder, Room
 from vc_gym.sim.scenes.furniture import ceiling_texture, sun
 
 #: Name the test scene is registered under.
@@ -38,7 +39,7 @@ def box_room(b: Builder) -> SceneLayout:
 
     Large enough for LearnThenHome's learning spots 1 m around home (the origin).
     """
-    room = Room(b, BOUNDS, 2.4, {s: b.var.colour(rgb, dh=0.02) for s, rgb in WALL_RGB.items()})
+    room = Room(b, BOUNDS, 2.4, {s: b.choices.colour(rgb, dh=0.02) for s, rgb in WALL_RGB.items()})
     poster = textures.procedural_poster(b.rng, (96, 64), "blocks")
     north = room.walls["N"]  # u from the west end (x = -2.5) eastwards
     north.canvas.framed(3.7, 4.3, 0.5, 1.4, poster, (25, 25, 25), 0.04)
@@ -191,7 +192,7 @@ def test_cli_refuses_an_unknown_scene_before_any_work(command, tmp_path, capsys,
     def no_work(args):  # pragma: no cover - must not run
         raise AssertionError("the command ran")
 
-    monkeypatch.setattr(cli, f"_cmd_{command}", no_work)
+    monkeypatch.setattr(getattr(cli, command), "run", no_work)
     with pytest.raises(SystemExit) as e:
         cli.main([command, "--scene", BOX_ROOM, "--out", str(tmp_path)])
     assert e.value.code == 2

@@ -8,6 +8,7 @@ import pytest
 import vc_gym.sim
 from vc_gym.sim.scenes import (
     SCENES,
+    Builder,
     SceneLayout,
     build_scene,
     check_scene_name,
@@ -15,7 +16,6 @@ from vc_gym.sim.scenes import (
     scene_names,
     unregister_scene,
 )
-from vc_gym.sim.scenes.base import Builder
 
 
 @pytest.fixture
@@ -168,7 +168,7 @@ def test_builder_draws_from_the_canonical_seed_or_the_rng(bc, names):
 
     def record(b: Builder) -> SceneLayout:
         draws.append(float(b.rng.uniform()))
-        draws.append(b.var.uniform(0.5, 0.0, 1.0))
+        draws.append(b.choices.uniform(0.5, 0.0, 1.0))
         return slab(b)
 
     names.append("test_seeded")

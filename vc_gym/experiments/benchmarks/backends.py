@@ -17,8 +17,9 @@ from typing import Any
 
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.homing import run_homing
+from vc_gym.jobs.backends import LocalBackend, RayBackend
 from vc_gym.jobs.output import read_json
-from vc_gym.jobs.runner import LocalBackend, RayBackend, check_workers
+from vc_gym.jobs.workers import check_workers
 from vc_gym.validation import MAX_EPISODES, check_seed, int_in_range, positive_float
 
 __all__ = ["bench_backends"]
@@ -41,7 +42,7 @@ def bench_backends(
         :data:`~vc_gym.validation.MAX_EPISODES`).
     workers : int
         Workers of the parallel backends (2 to
-        :func:`~vc_gym.jobs.runner.max_workers`).
+        :func:`~vc_gym.jobs.workers.max_workers`).
     seed : int
         Learning seed (the atlas is learned once, before any timing).
     learn_time_s, max_homing_s : float

@@ -15,7 +15,8 @@ import numpy as np
 
 from vc_gym.compass import AIBO_RESOLUTION, Camera, CompassConfig, VisualCompass
 from vc_gym.validation import check_seed, int_in_range
-from vc_gym.worlds.panorama import make_panorama, render_view
+from vc_gym.worlds.panorama import render_view
+from vc_gym.worlds.panorama_painters import make_panorama
 
 __all__ = ["MAX_FRAMES", "MAX_INNER", "MAX_REPEATS", "bench_compass"]
 

@@ -38,14 +38,10 @@ from typing import Any
 import numpy as np
 
 import vc_gym  # noqa: F401  (registers the envs)
-from vc_gym.jobs.runner import check_workers
-from vc_gym.training.train import (
-    COLLECTORS,
-    TrainConfig,
-    learn_places,
-    train,
-    training_env,
-)
+from vc_gym.jobs.workers import check_workers
+from vc_gym.training.config import COLLECTORS, TrainConfig
+from vc_gym.training.environments import learn_places, training_env
+from vc_gym.training.train import train
 from vc_gym.validation import check_seed, int_in_range
 
 __all__ = ["MAX_ENV_STEPS", "MAX_TIMESTEPS", "bench_train"]
@@ -95,7 +91,7 @@ def bench_train(
         otherwise; 1 to :data:`MAX_TIMESTEPS`).
     n_envs : int
         Worker processes of the training runs (1 to
-        :func:`~vc_gym.jobs.runner.max_workers`).
+        :func:`~vc_gym.jobs.workers.max_workers`).
     env_steps : int
         Decisions of each single-env round (one before the first training and one after
         each; every round takes the same actions; 1 to :data:`MAX_ENV_STEPS`).

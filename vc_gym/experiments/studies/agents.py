@@ -20,8 +20,10 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.experiments.episode import DEFAULT_HOMING_MODE
+from vc_gym.experiments.studies import get_experiment
 from vc_gym.experiments.studies.common import ExperimentOptions
-from vc_gym.experiments.studies.homing import PAPER_MEAN_CM, PAPER_STD_CM, mean_std, run_homing
+from vc_gym.experiments.studies.kidnapping import PAPER_MEAN_CM, PAPER_STD_CM, mean_std
 from vc_gym.jobs.output import check_out_dir, new_figure, save_figure, write_json
 
 __all__ = ["agent_list", "run_agents", "summary_lines"]
@@ -64,7 +66,7 @@ def run_agents(
     episodes: int | None = None,
     learn_time_s: float | None = None,
     max_homing_s: float | None = None,
-    mode: str = "paper",
+    mode: str = DEFAULT_HOMING_MODE,
     allow_imports: bool = False,
 ) -> dict[str, Any]:
     """Run the homing experiment for every agent on the same kidnappings.
@@ -97,6 +99,7 @@ def run_agents(
     order = [agents.index("scripted")] + [i for i, a in enumerate(agents) if a != "scripted"]
     per_agent: dict[str, dict[str, Any]] = {}
     atlas_dir = opts.atlas_dir
+    run_homing = get_experiment("homing").runner()
     for i in order:
         sub = out / labels[i]
         if opts.progress:

@@ -1,17 +1,34 @@
-"""What every experiment shares: sizes, seeds, the run folder and progress."""
+"""What every experiment shares: sizes, seeds, the run folder, progress, checked
+scenes and trackers, and the old places of moved names."""
 
 from __future__ import annotations
 
+import json
 import os
-from collections.abc import Iterable, Mapping
+import warnings
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
 
-from vc_gym.jobs.runner import ExperimentRun, LocalBackend, RayBackend, make_backend
+from vc_gym.jobs.backends import LocalBackend, RayBackend, make_backend
+from vc_gym.jobs.run import ExperimentRun
+from vc_gym.localization import make_tracker
 
-__all__ = ["SIZES", "ExperimentOptions", "median_timings", "open_run", "pick_size"]
+__all__ = [
+    "SIZES",
+    "ExperimentOptions",
+    "check_scenes",
+    "check_tracker_spec",
+    "median_timings",
+    "moved_names",
+    "one_scene",
+    "open_run",
+    "pick_size",
+    "scene_field_bounds",
+]
 
 #: ``quick``: the size the tests use (seconds to a minute); ``paper``: the size of the
 #: ``paper`` report (all experiments in < 20 min on 2 cores); ``full``: the default.
@@ -97,3 +114,54 @@ def median_timings(timings: Iterable[Mapping[str, float]]) -> dict[str, float]:
         for name, ms in timing.items():
             per.setdefault(name, []).append(ms)
     return {n: round(float(np.median(v)), 3) for n, v in per.items()}
+
+
+def one_scene(scenes: Sequence[str] | None, experiment: str) -> str:
+    """The one scene of an experiment that runs in a single scene (default robolab)."""
+    scenes = list(scenes or ["robolab"])
+    if len(scenes) != 1:
+        raise ValueError(f"the {experiment} runs in one scene, got {scenes}")
+    return scenes[0]
+
+
+def check_scenes(scenes: Sequence[str]) -> list[str]:
+    """Registered scene names, each once (a clear error otherwise)."""
+    from vc_gym.sim.scenes import check_scene_name
+
+    out = [check_scene_name(s) for s in scenes]
+    if len(set(out)) != len(out):
+        raise ValueError(f"scenes given twice: {out}")
+    return out
+
+
+def check_tracker_spec(tracker: Any) -> Any:
+    """A tracker that can travel to a worker: a name, ``"module:factory"`` or a dict."""
+    if not (isinstance(tracker, str) or (isinstance(tracker, Mapping) and "type" in tracker)):
+        raise ValueError(
+            "an experiment's tracker must be a name, 'package.module:factory' or a "
+            f'{{"type": ...}} dict (the jobs run in other processes), got {tracker!r}'
+        )
+    make_tracker(tracker)  # an unknown tracker fails here, not in a worker
+    return json.loads(json.dumps(tracker))
+
+
+def moved_names(module: str, moves: Mapping[str, tuple[ModuleType, str]]) -> Callable[[str], Any]:
+    """A module ``__getattr__`` (PEP 562) serving public names that moved elsewhere.
+
+    ``moves`` maps each old name to ``(new module, new name)``. For one release the old
+    name still gives the very same object, with a ``DeprecationWarning`` that names its
+    new place; any other missing name is an ``AttributeError`` as usual.
+    """
+
+    def __getattr__(name: str) -> Any:
+        if name not in moves:
+            raise AttributeError(f"module {module!r} has no attribute {name!r}")
+        new_module, new_name = moves[name]
+        warnings.warn(
+            f"{module}.{name} moved to {new_module.__name__}.{new_name}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(new_module, new_name)
+
+    return __getattr__

@@ -13,9 +13,8 @@ T = (100, 0) cm where the robot stands).
 
 from __future__ import annotations
 
-import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,48 +24,55 @@ from vc_gym.agents.learned import PRETRAINED_MODEL, LearnedHomingAgent
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.envs.homing import home_offset
 from vc_gym.envs.learning import HOME
-from vc_gym.experiments.atlases import SavedAtlas, atlas_key, atlas_spec, ensure_atlases
-from vc_gym.experiments.episode import HOMING_MODES, homing_mode, make_homing_run, run_episode
+from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
+from vc_gym.experiments.episode import (
+    DEFAULT_HOMING_MODE,
+    HOMING_MODES,
+    canonical_homing_mode,
+    check_agent_env,
+)
 from vc_gym.experiments.spot_sensors import spot_sensor_job
+from vc_gym.experiments.studies import kidnapping
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
+    check_tracker_spec,
+    moved_names,
     open_run,
     pick_size,
     scene_field_bounds,
 )
-from vc_gym.experiments.video import write_episode_video
+from vc_gym.experiments.studies.kidnapping import EPISODE_JOB
 from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
-from vc_gym.heading_sensors import (
-    IMAGE_SENSORS,
-    SENSOR_GRID,
-    MagnetometerCompass,
-    NoisyMagneticCompass,
-)
+from vc_gym.heading_sensors import IMAGE_SENSORS, SENSOR_GRID
+from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
-from vc_gym.jobs.runner import Job, worker_cache
-from vc_gym.localization import make_tracker
+from vc_gym.jobs.workers import worker_cache
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.sim.scenes import check_scene_name
 from vc_gym.validation import flag, positive_float
 
-__all__ = [
-    "PAPER_MEAN_CM",
-    "PAPER_STD_CM",
-    "episode_job",
-    "mean_std",
-    "run_homing",
-    "spread_over_seeds",
-    "summarise_stops",
-]
+__all__ = ["run_homing", "summary_lines"]
 
-PAPER_MEAN_CM = (-22.0, 12.0)
-PAPER_STD_CM = (17.0, 15.0)
+#: Names that moved to :mod:`~vc_gym.experiments.studies.kidnapping` (shared by every
+#: experiment that homes): served here for one release, with a DeprecationWarning.
+__getattr__ = moved_names(
+    __name__,
+    {
+        name: (kidnapping, name)
+        for name in (
+            "PAPER_MEAN_CM",
+            "PAPER_STD_CM",
+            "episode_job",
+            "mean_std",
+            "spread_over_seeds",
+            "summarise_stops",
+        )
+    },
+)
+
 #: How the place is learned and the scripted agent homes, by name (see
 #: :data:`~vc_gym.experiments.episode.HOMING_MODES`).
 MODES = HOMING_MODES
-#: A stop this far from home is a "far stop": the robot trusted a position it had no
-#: evidence for (or never found home).
-FAR_STOP_M = 0.5
 #: Frames per learning direction of a ``--sensor`` at home, by size.
 SENSOR_FRAMES = {"quick": 2, "paper": 8, "full": 8}
 #: ``--sensor`` name of the magnetometer (it reads the true heading, not images).
@@ -100,103 +106,6 @@ SIZES = {
 }
 
 
-def check_tracker_spec(tracker: Any) -> Any:
-    """A tracker that can travel to a worker: a name, ``"module:factory"`` or a dict."""
-    if not (isinstance(tracker, str) or (isinstance(tracker, Mapping) and "type" in tracker)):
-        raise ValueError(
-            "an experiment's tracker must be a name, 'package.module:factory' or a "
-            f'{{"type": ...}} dict (the jobs run in other processes), got {tracker!r}'
-        )
-    make_tracker(tracker)  # an unknown tracker fails here, not in a worker
-    return json.loads(json.dumps(tracker))
-
-
-def _run_for(kwargs: Mapping[str, Any]):
-    atlas = kwargs["atlas"]
-    run = make_homing_run(
-        kwargs["agent"],
-        tracker=kwargs["tracker"],
-        scene=kwargs["scene"],
-        learn_time_s=kwargs["learn_time_s"],
-        success_radius_m=kwargs["success_radius_m"],
-        relearn="scene" if atlas else "episode",
-        max_homing_s=kwargs["max_homing_s"],
-        learner=SavedAtlas(atlas) if atlas else None,
-        keep_image=kwargs.get("video") is not None,
-        mode=kwargs.get("mode", "paper"),
-        policy=None
-        if kwargs.get("home_offset_m") is None
-        else {"home_offset_m": tuple(kwargs["home_offset_m"])},
-        allow_imports=kwargs.get("allow_imports", False),
-    )
-    if atlas:
-        run.env.reset(seed=kwargs["learning_seed"])  # loads the saved atlas
-    return run
-
-
-def episode_job(
-    agent: str,
-    tracker: Any,
-    scene: str,
-    learn_time_s: float,
-    success_radius_m: float,
-    max_homing_s: float,
-    atlas: str | None,
-    learning_seed: int,
-    episode_seed: int,
-    video: str | None = None,
-    mode: str = "paper",
-    magnetometer: bool = False,
-    home_offset_m: list[float] | None = None,
-    allow_imports: bool = False,
-) -> dict[str, Any]:
-    """Job: one kidnapping (seed ``episode_seed``) with the saved ``atlas``.
-
-    ``atlas=None`` learns anew in the episode (``relearn="episode"``). With ``video``
-    the episode is also written there as MP4. ``mode`` is the homing mode (its policy;
-    a saved atlas brings its own learning). With ``magnetometer`` the grid tracker's
-    heading sensor is a magnetometer in the robot's head (the disturbance field of
-    :meth:`NoisyMagneticCompass.random_field` seeded by the learning seed, its noise by
-    the episode's). ``home_offset_m``: the scripted agent's goal correction.
-    ``allow_imports``: a learned agent's ``config.json`` may name an import path. Returns
-    the episode's figures.
-    """
-    kwargs = dict(locals())
-    cache_key = json.dumps(
-        {k: v for k, v in kwargs.items() if k not in ("episode_seed",)}, sort_keys=True
-    )
-    run = worker_cache(("homing-run", cache_key), lambda: _run_for(kwargs))
-    if magnetometer:
-        _fit_magnetometer(run, learning_seed, episode_seed)
-    if video is not None:
-        record = write_episode_video(run, episode_seed, video)
-    else:
-        record = run_episode(run, seed=episode_seed)
-    out = record.summary()
-    out["learning_seed"] = learning_seed
-    ms = 1e3 * record.tracker_time_s / record.tracker_updates if record.tracker_updates else None
-    out["timing"] = {"tracker_ms_per_update": ms}
-    return out
-
-
-def _fit_magnetometer(run: Any, learning_seed: int, episode_seed: int) -> None:
-    """Make a magnetometer in the robot's head the grid tracker's heading sensor."""
-    room = run.env.unwrapped.room
-    field = NoisyMagneticCompass.random_field(
-        room.scene.field_bounds, np.random.default_rng([learning_seed, 97])
-    )
-    robot = room.robot
-
-    def head_pose() -> tuple[float, float, float]:
-        x, y, yaw = robot.pose
-        return x, y, yaw + float(robot.head[0])
-
-    tracker = run.env.get_wrapper_attr("tracker")
-    tracker.heading_sensor = MagnetometerCompass(
-        field, head_pose, np.random.default_rng([episode_seed, 98])
-    )
-
-
 def field_job(
     scene: str, atlas: str, x: float, y: float, headings: list[float], frames: int, seed: int
 ) -> dict[str, Any]:
@@ -214,48 +123,6 @@ def field_job(
     }
 
 
-def summarise_stops(episodes: Sequence[Mapping[str, Any]], success_radius_m: float) -> dict:
-    """Mean / std stop offset per axis (cm), distances, success and far stops."""
-    off = np.array([e["stop_offset_m"] for e in episodes], np.float64) * 100.0
-    dist = np.hypot(off[:, 0], off[:, 1])
-    n = len(episodes)
-    return {
-        "episodes": n,
-        "mean_stop_offset_cm": off.mean(axis=0).round(1).tolist(),
-        "std_stop_offset_cm": off.std(axis=0, ddof=1).round(1).tolist() if n > 1 else None,
-        "mean_stop_distance_cm": round(float(dist.mean()), 1),
-        "median_stop_distance_cm": round(float(np.median(dist)), 1),
-        "success_rate": round(float(np.mean([e["success"] for e in episodes])), 4),
-        "success_radius_m": success_radius_m,
-        "far_stops": int(
-            sum(e["stopped"] and d > FAR_STOP_M * 100 for e, d in zip(episodes, dist, strict=True))
-        ),
-        "stopped": int(sum(e["stopped"] for e in episodes)),
-        "timed_out": int(sum(e["timed_out"] for e in episodes)),
-        "fell": int(sum(e["fell"] for e in episodes)),
-        "mean_homing_time_s": round(float(np.mean([e["sim_time_s"] for e in episodes])), 1),
-        "mean_heading_error_deg": round(
-            float(np.mean([e["mean_heading_error_deg"] or 0.0 for e in episodes])), 2
-        ),
-    }
-
-
-def mean_std(values: Sequence[float]) -> list[float]:
-    """``[mean, sample std (ddof 1; 0 for one value)]``, rounded to 4 decimals."""
-    v = np.asarray(values, np.float64)
-    return [round(float(v.mean()), 4), round(float(v.std(ddof=1)) if v.size > 1 else 0.0, 4)]
-
-
-def spread_over_seeds(per_seed: Sequence[Mapping[str, Any]]) -> dict[str, list[float]]:
-    """``[mean, std]`` over learning seeds of :func:`summarise_stops`' success and distance."""
-    return {
-        "success_rate_over_seeds": mean_std([p["success_rate"] for p in per_seed]),
-        "mean_stop_distance_cm_over_seeds": mean_std(
-            [p["mean_stop_distance_cm"] for p in per_seed]
-        ),
-    }
-
-
 def run_homing(
     out_dir: str | os.PathLike,
     opts: ExperimentOptions | None = None,
@@ -269,7 +136,7 @@ def run_homing(
     success_radius_m: float = 0.3,
     relearn: str = "scene",
     field: bool = True,
-    mode: str = "paper",
+    mode: str = DEFAULT_HOMING_MODE,
     sensor: str | None = None,
     home_offset_m: Sequence[float] | None = None,
     allow_imports: bool = False,
@@ -303,7 +170,7 @@ def run_homing(
     field : bool
         Also measure the likelihood field of fig. 5 (right).
     mode : str
-        ``"paper"`` or ``"improved"`` (:data:`MODES`: how the place is learned and how
+        ``"check-home"`` (default) or ``"paper"`` (:data:`MODES`: how the place is learned and how
         the scripted agent homes).
     sensor : str, optional
         An image sensor of :data:`vc_gym.heading_sensors.IMAGE_SENSORS` (``"feature"``,
@@ -344,7 +211,7 @@ def run_homing(
         positive_float(name, v)
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
-    homing_mode(mode)
+    mode = canonical_homing_mode(mode)
     tracker = check_tracker_spec(tracker)
     if sensor is not None:
         grid_options = _sensor_tracker_options(sensor, tracker, relearn)
@@ -362,7 +229,7 @@ def run_homing(
         agent = str(Path(agent).resolve())
         # a bad model fails here, not in a worker
         learned = LearnedHomingAgent(agent, allow_imports)
-        learned.check_env()  # and so does a config.json the env refuses
+        check_agent_env(learned, str(learned.config_path))  # and a config the env refuses
         scene = learned.scene
     else:
         check_scene_name(scene)
@@ -424,15 +291,15 @@ def run_homing(
             }
             if n < opts.video:
                 kwargs["video"] = str((videos / f"seed{s}-episode{i:03d}.mp4").resolve())
-            jobs.append(Job(f"seed{s}-episode{i:03d}", f"{__name__}:episode_job", kwargs))
+            jobs.append(Job(f"seed{s}-episode{i:03d}", EPISODE_JOB, kwargs))
     if opts.video:
         videos.mkdir(exist_ok=True)
     outputs = run.run("episodes", jobs)
     done = [o for o in outputs if o is not None]
     results: dict[str, Any] = {
         "paper": {
-            "mean_stop_offset_cm": list(PAPER_MEAN_CM),
-            "std_stop_offset_cm": list(PAPER_STD_CM),
+            "mean_stop_offset_cm": list(kidnapping.PAPER_MEAN_CM),
+            "std_stop_offset_cm": list(kidnapping.PAPER_STD_CM),
             "episodes": 33,
         },
     }
@@ -440,12 +307,12 @@ def run_homing(
     for s in seeds:
         eps = [o for o in done if o["learning_seed"] == s]
         if eps:
-            per_seed.append({"seed": s, **summarise_stops(eps, success_radius_m)})
+            per_seed.append({"seed": s, **kidnapping.summarise_stops(eps, success_radius_m)})
     results["per_seed"] = per_seed
     if done:
-        overall = summarise_stops(done, success_radius_m)
+        overall = kidnapping.summarise_stops(done, success_radius_m)
         if len(per_seed) > 1:
-            overall.update(spread_over_seeds(per_seed))
+            overall.update(kidnapping.spread_over_seeds(per_seed))
         results["overall"] = overall
         _plot_stops(run.out / "stop_positions.png", done, settings, overall)
     if field and relearn == "scene":
@@ -553,7 +420,14 @@ def _plot_stops(path: Path, episodes, settings, overall) -> None:
     ax.plot(0, 0, "+", color="k", ms=14, mew=2, label="home")
     m = overall["mean_stop_offset_cm"]
     ax.plot(*m, "o", mfc="none", mec="tab:red", ms=12, mew=2, label=f"mean ({m[0]}, {m[1]}) cm")
-    ax.plot(*PAPER_MEAN_CM, "s", mfc="none", mec="k", ms=10, label="paper's mean (−22, 12) cm")
+    ax.plot(
+        *kidnapping.PAPER_MEAN_CM,
+        "s",
+        mfc="none",
+        mec="k",
+        ms=10,
+        label="paper's mean (−22, 12) cm",
+    )
     ax.add_patch(
         Circle((0, 0), settings["success_radius_m"] * 100, fill=False, ls="--", color="0.5")
     )

@@ -17,13 +17,13 @@ from typing import Any
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
+    one_scene,
     open_run,
     pick_size,
     scene_field_bounds,
 )
-from vc_gym.experiments.studies.orientation import (
+from vc_gym.experiments.studies.orientation_grid import (
     headline_errors,
-    one_scene,
     rear_half_centre,
     view_jobs,
     views_summary,

@@ -18,13 +18,12 @@ a finer grid of test poses. Two position estimates are compared on the same fram
     and whose spread its uncertainty.
 
 The same two, and a third, are also computed from a **full turn** on the spot: the robot
-turns through ``turn_headings`` directions (the checking turn of the improved homing
+turns through ``turn_headings`` directions (the checking turn of the check-home homing
 policy) and each spot's score is averaged over the turn. A single view's score depends
-on where the camera looks as much as on where the robot stands (frame-to-frame spread
-0.05–0.07 at one place); over a turn that spread falls to about 0.02, so the distance
-information carries. Calibration for the turn methods uses turns at the calibration
-points, which here also include points on the field's border beyond the outer spots
-(where a learning robot can walk too):
+on where the camera looks as much as on where the robot stands; over a turn much of
+that spread averages out, so the distance information carries. Calibration for the
+turn methods uses turns at the calibration points, which here also include points on
+the field's border beyond the outer spots (where a learning robot can walk too):
 
 ``turn_calibrated``
     The ``calibrated`` likelihood on turn-averaged scores and turn calibration.
@@ -32,6 +31,11 @@ points, which here also include points on the field's border beyond the outer sp
     Place recognition by the turn's score signature: the ``k`` calibration places whose
     turn-averaged scores are nearest (each spot's score divided by its residual spread),
     weighted by inverse signature distance; their weighted spread is the uncertainty.
+
+The estimators are public in :mod:`vc_gym.localization`
+(:func:`~vc_gym.localization.locate_by_goodness`,
+:func:`~vc_gym.localization.locate_by_turn_signature`); this module takes the frames in
+the simulator and compares them.
 
 Results: mean, median and 90th-percentile position error over the field per method, the
 share of true positions inside each uncertain method's 2σ, and a PNG of the error fields.
@@ -48,28 +52,47 @@ from typing import Any
 
 import numpy as np
 
+import vc_gym.localization
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
+    moved_names,
+    one_scene,
     open_run,
     pick_size,
     scene_field_bounds,
 )
-from vc_gym.experiments.studies.orientation import one_scene
 from vc_gym.experiments.views import field_grid, look, view_poses
+from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
-from vc_gym.jobs.runner import Job, worker_cache
+from vc_gym.jobs.workers import worker_cache
+from vc_gym.localization import (
+    calibrate_goodness,
+    goodness_calibration,
+    locate_by_goodness,
+    locate_by_turn_signature,
+    mean_spot_scores,
+)
+from vc_gym.localization.spot_scores import finite_array
+from vc_gym.localization.turn_signature import NEAREST_K
 from vc_gym.sim.aibo_room import AiboRoomEnv
 
-__all__ = [
-    "calibrate",
-    "calibration_points",
-    "locate_calibrated",
-    "locate_eq30",
-    "locate_nearest",
-    "run_localization",
-    "summary_lines",
-]
+__all__ = ["locate_eq30", "run_localization", "summary_lines"]
+
+#: The estimators moved to :mod:`vc_gym.localization` (public API for trackers and
+#: agents): their old names here still work for one release, with a DeprecationWarning.
+__getattr__ = moved_names(
+    __name__,
+    {
+        "calibrate": (vc_gym.localization, "calibrate_goodness"),
+        "calibration_points": (vc_gym.localization, "calibration_points"),
+        "locate_calibrated": (vc_gym.localization, "locate_by_goodness"),
+        "locate_nearest": (vc_gym.localization, "locate_by_turn_signature"),
+        "BORDER_MARGIN_M": (goodness_calibration, "BORDER_MARGIN_M"),
+        "GRID_STEP_M": (goodness_calibration, "GRID_STEP_M"),
+        "LENGTH_SCALES_M": (goodness_calibration, "LENGTH_SCALES_M"),
+    },
+)
 
 SIZES = {
     "quick": {
@@ -105,12 +128,6 @@ SIZES = {
 }
 #: Margin of the spot grid inside the field (metres).
 SPOT_MARGIN_M = 0.5
-#: Resolution of the calibrated position likelihood (metres).
-GRID_STEP_M = 0.05
-#: Calibration places whose signatures make a ``turn_nearest`` estimate.
-NEAREST_K = 3
-#: Distance kept from the field's edges by border calibration points (metres).
-BORDER_MARGIN_M = 0.25
 
 
 def _room(scene: str) -> AiboRoomEnv:
@@ -132,9 +149,10 @@ def learn_grid_job(
     Colour classes are fitted once, on the first frame of every direction at the spot
     nearest the field centre, and shared by every map (the goodness of different spots
     is then comparable). Calibration frames (random headings, not learned) are taken at
-    every calibration point (:func:`calibration_points`, with the field's border); their
-    raw scores under every map are saved with the atlas, and with ``turn_headings`` also
-    the scores averaged over a turn at each point (:func:`turn_scores`).
+    every calibration point (:func:`~vc_gym.localization.calibration_points`, with the
+    field's border); their raw scores under every map are saved with the atlas, and
+    with ``turn_headings`` also the scores averaged over a turn at each point
+    (:func:`turn_scores`).
     """
     room = _room(scene)
     room.reset(seed=seed)
@@ -155,7 +173,7 @@ def learn_grid_job(
     atlas = CompassAtlas(maps, home=f"spot{centre}")
     rng = np.random.default_rng([seed, 77])
     positions, scores, turns = [], [], []
-    places = calibration_points(pts, room.scene.field_bounds)
+    places = vc_gym.localization.calibration_points(pts, room.scene.field_bounds)
     for i, (x, y) in enumerate(places):
         for h in rng.uniform(0.0, 360.0, calibration_headings):
             for image, _, _ in look(room, (x, y, float(h)), 2, seed=seed + 50_000 + i):
@@ -195,10 +213,11 @@ def turn_scores(
     """Every spot's raw score averaged over a turn on the spot.
 
     The robot is put at ``position`` facing ``start_deg + k·360/headings`` for
-    ``k = 0 … headings−1`` and takes ``frames`` frames (head scanning) at each.
+    ``k = 0 … headings−1`` and takes ``frames`` frames (head scanning) at each: the
+    turn's signature (:func:`~vc_gym.localization.mean_spot_scores`).
     """
-    raws = [
-        atlas.scores(image, camera)[0]
+    images = [
+        image
         for k in range(headings)
         for image, _, _ in look(
             room,
@@ -207,51 +226,7 @@ def turn_scores(
             seed=seed + k,
         )
     ]
-    return np.mean(raws, axis=0)
-
-
-def calibration_points(spots: np.ndarray, bounds: Sequence[float] | None = None) -> np.ndarray:
-    """The spots and the midpoints between neighbouring spots: where a robot that walks
-    from spot to spot while learning passes, knowing by odometry where it is.
-
-    With the field's ``bounds`` also border points: every outermost spot of a row or
-    column moved out to :data:`BORDER_MARGIN_M` inside the field's edge (and the four
-    corners), so that calibration also covers the strip beyond the outer spots.
-    """
-    pts = _array("spots", spots, (None, 2))
-    border = _border_points(pts, bounds) if bounds is not None else np.zeros((0, 2))
-    d = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
-    nearest = np.min(np.where(d > 0, d, np.inf), axis=1)
-    mids = [
-        (pts[i] + pts[j]) / 2
-        for i in range(len(pts))
-        for j in range(i + 1, len(pts))
-        if d[i, j] <= 1.01 * max(nearest[i], nearest[j])
-    ]
-    out = list(np.vstack([pts, *mids]) if mids else pts)
-    for p in border:  # each border point once, and none that is already a place
-        if not np.any(np.all(np.abs(np.asarray(out) - p) < 1e-6, axis=1)):
-            out.append(p)
-    return np.array(out, np.float64)
-
-
-def _border_points(pts: np.ndarray, bounds: Sequence[float]) -> np.ndarray:
-    x0, x1, y0, y1 = _array("bounds", bounds, (4,))
-    if not (x0 < x1 and y0 < y1):
-        raise ValueError(f"bounds must be (xmin, xmax, ymin, ymax) with min < max, got {bounds}")
-    m = BORDER_MARGIN_M
-    lo_x, hi_x, lo_y, hi_y = x0 + m, x1 - m, y0 + m, y1 - m
-    out = []
-    for y in np.unique(pts[:, 1]):
-        row = pts[pts[:, 1] == y, 0]
-        out += [(lo_x, y)] if row.min() > lo_x + 1e-6 else []
-        out += [(hi_x, y)] if row.max() < hi_x - 1e-6 else []
-    for x in np.unique(pts[:, 0]):
-        col = pts[pts[:, 0] == x, 1]
-        out += [(x, lo_y)] if col.min() > lo_y + 1e-6 else []
-        out += [(x, hi_y)] if col.max() < hi_y - 1e-6 else []
-    out += [(lo_x, lo_y), (lo_x, hi_y), (hi_x, lo_y), (hi_x, hi_y)]
-    return np.array(out, np.float64)
+    return mean_spot_scores(atlas, images, camera)
 
 
 def locate_job(
@@ -271,11 +246,8 @@ def locate_job(
     camera = Camera(hfov_deg=room.camera.hfov_deg)
     out = []
     for k, pose in enumerate(poses):
-        raws = [
-            loaded.scores(image, camera)[0]
-            for image, _, _ in look(room, tuple(pose), frames, seed=seed + k)
-        ]
-        view = {"pose": pose, "scores": np.mean(raws, axis=0).round(6).tolist()}
+        images = [image for image, _, _ in look(room, tuple(pose), frames, seed=seed + k)]
+        view = {"pose": pose, "scores": mean_spot_scores(loaded, images, camera).round(6).tolist()}
         if turn_headings:
             turn = turn_scores(
                 room,
@@ -292,116 +264,29 @@ def locate_job(
     return {"views": out}
 
 
-def _array(name: str, value: object, shape: tuple[int | None, ...]) -> np.ndarray:
-    """``value`` as a finite float array of ``shape`` (None: any length), or a ValueError."""
-    a = np.asarray(value, dtype=np.float64)
-    if a.ndim != len(shape) or any(
-        w is not None and n != w for n, w in zip(a.shape, shape, strict=False)
-    ):
-        raise ValueError(f"{name} must have shape {shape} (None: any), got {a.shape}")
-    if a.size == 0 or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must be non-empty and finite")
-    return a
-
-
-#: Length scales tried for the saturating fall of goodness with distance (metres).
-LENGTH_SCALES_M = (0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0)
-
-
-def _falloff(d: np.ndarray, length_m: float) -> np.ndarray:
-    return 1.0 - np.exp(-d / length_m)
-
-
-def calibrate(
-    spots: np.ndarray, positions: np.ndarray, scores: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """Fit ``score_i ≈ a_i − b_i·(1 − exp(−d/λ))`` per spot on frames at known positions.
-
-    Goodness falls steeply within the first metre and then levels off (measured: the
-    mean score of a spot's map drops from about −0.08 at the spot to −0.2 at 1.5 m and
-    −0.27 beyond 3 m), so a straight line fits badly. ``λ`` is shared by all spots and
-    chosen by least squares from :data:`LENGTH_SCALES_M`; ``b`` is kept >= 0 and
-    ``sigma`` (residual standard deviation per spot) >= 1e-3.
-
-    Returns ``(a, b, sigma, λ)``.
-    """
-    spots = _array("spots", spots, (None, 2))
-    positions = _array("positions", positions, (None, 2))
-    n = spots.shape[0]
-    scores = _array("scores", scores, (positions.shape[0], n))
-    best = None
-    for length in LENGTH_SCALES_M:
-        a, b, sigma = np.zeros(n), np.zeros(n), np.zeros(n)
-        for i in range(n):
-            f = _falloff(np.hypot(*(positions - spots[i]).T), length)
-            design = np.stack([np.ones_like(f), -f], axis=1)
-            coef, *_ = np.linalg.lstsq(design, scores[:, i], rcond=None)
-            a[i], b[i] = coef[0], max(coef[1], 0.0)
-            sigma[i] = max(float((scores[:, i] - (a[i] - b[i] * f)).std()), 1e-3)
-        cost = float((sigma**2).sum())
-        if best is None or cost < best[0]:
-            best = (cost, a, b, sigma, length)
-    _, a, b, sigma, length = best
-    return a, b, sigma, length
-
-
-def locate_calibrated(
-    scores: np.ndarray, spots: np.ndarray, model: tuple, bounds: Sequence[float]
-) -> tuple[np.ndarray, np.ndarray]:
-    """Posterior mean and per-axis std of the position given each spot's raw score."""
-    spots = _array("spots", spots, (None, 2))
-    scores = _array("scores", scores, (spots.shape[0],))
-    a, b, sigma, length = model
-    x0, x1, y0, y1 = bounds
-    gx = np.arange(x0, x1 + 1e-9, GRID_STEP_M)
-    gy = np.arange(y0, y1 + 1e-9, GRID_STEP_M)
-    xx, yy = np.meshgrid(gx, gy)
-    cells = np.stack([xx.ravel(), yy.ravel()], axis=1)
-    d = np.hypot(cells[:, None, 0] - spots[None, :, 0], cells[:, None, 1] - spots[None, :, 1])
-    expected = a[None, :] - b[None, :] * _falloff(d, length)
-    logl = -0.5 * (((scores[None, :] - expected) / sigma[None, :]) ** 2).sum(axis=1)
-    w = np.exp(logl - logl.max())
-    w /= w.sum()
-    mean = w @ cells
-    std = np.sqrt(np.maximum(w @ (cells - mean) ** 2, 0.0))
-    return mean, std
-
-
-def locate_nearest(
-    scores: np.ndarray,
-    places: np.ndarray,
-    place_scores: np.ndarray,
-    sigma: np.ndarray,
-    k: int = NEAREST_K,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Position from the ``k`` places whose score signatures are nearest.
-
-    Signature distance: Euclidean over spots of ``(scores − place_scores) / sigma``;
-    weights ``∝ 1 / distance``. Returns the weighted mean position and the per-axis
-    weighted spread of the ``k`` places (at least :data:`GRID_STEP_M`).
-    """
-    places = _array("places", places, (None, 2))
-    place_scores = _array("place_scores", place_scores, (places.shape[0], None))
-    n = place_scores.shape[1]
-    scores = _array("scores", scores, (n,))
-    sigma = _array("sigma", sigma, (n,))
-    if np.any(sigma <= 0):
-        raise ValueError("sigma must be > 0")
-    if isinstance(k, bool) or not isinstance(k, int | np.integer) or k < 1:
-        raise ValueError(f"k must be an int >= 1, got {k!r}")
-    d = np.sqrt((((place_scores - scores[None, :]) / sigma[None, :]) ** 2).sum(axis=1))
-    nearest = np.argsort(d, kind="stable")[: min(k, len(d))]
-    w = 1.0 / (d[nearest] + 1e-9)
-    w /= w.sum()
-    mean = w @ places[nearest]
-    std = np.sqrt(np.maximum(w @ (places[nearest] - mean) ** 2, GRID_STEP_M**2))
-    return mean, std
-
-
 def locate_eq30(scores: np.ndarray, spots: np.ndarray, sharpness: float) -> np.ndarray:
-    """Eq. 30 over every spot: weights ``∝ exp(sharpness · score)``."""
-    spots = _array("spots", spots, (None, 2))
-    scores = _array("scores", scores, (spots.shape[0],))
+    """Eq. 30 over every spot: weights ``∝ exp(sharpness · score)``.
+
+    The paper's estimate, the baseline of this experiment: the spots' positions
+    weighted by ``L_i^sharpness`` (``L_i = exp(score_i)``, eq. 28), so a larger
+    sharpness snaps to the best-fitting spot.
+
+    Parameters
+    ----------
+    scores : array_like
+        ``(M,)`` raw score of the frame under each spot's map.
+    spots : array_like
+        ``(M, 2)`` training spots ``(x, y)``, metres.
+    sharpness : float
+        Exponent of the goodness (> 0), e.g. the atlas' ``sharpness``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(2,)`` the weighted mean of the spots.
+    """
+    spots = finite_array("spots", spots, (None, 2))
+    scores = finite_array("scores", scores, (spots.shape[0],))
     if not (np.isfinite(sharpness) and sharpness > 0):
         raise ValueError(f"sharpness must be finite and > 0, got {sharpness}")
     logw = sharpness * (scores - scores.max())
@@ -458,7 +343,7 @@ def run_localization(
         raise RuntimeError(f"learning the grid of spots failed; see {run.out / 'jobs' / 'learn'}")
     atlas, meta = CompassAtlas.load_with_metadata(path)
     cal = meta["calibration"]
-    model = calibrate(atlas.positions, np.array(cal["positions"]), np.array(cal["scores"]))
+    model = calibrate_goodness(atlas.positions, np.array(cal["positions"]), np.array(cal["scores"]))
 
     test = field_grid(bounds, size["test_spacing_m"], margin_m=0.25)
     poses = view_poses(test, size["headings"], np.random.default_rng([opts.seed, 91]))
@@ -487,10 +372,10 @@ def run_localization(
         },
         "spots": spot_list,
         "calibration": {
-            "a": model[0].round(5).tolist(),
-            "b": model[1].round(5).tolist(),
-            "sigma": model[2].round(5).tolist(),
-            "length_m": model[3],
+            "a": model.a.round(5).tolist(),
+            "b": model.b.round(5).tolist(),
+            "sigma": model.sigma.round(5).tolist(),
+            "length_m": model.length_m,
             "frames": len(cal["scores"]),
         },
         "methods": {},
@@ -501,22 +386,22 @@ def run_localization(
         spots = atlas.positions
         estimates: dict[str, tuple[np.ndarray, np.ndarray | None]] = {
             "paper": (np.array([locate_eq30(s, spots, atlas.sharpness) for s in scores]), None),
-            "calibrated": _stacked([locate_calibrated(s, spots, model, bounds) for s in scores]),
+            "calibrated": _stacked([locate_by_goodness(s, spots, model, bounds) for s in scores]),
         }
         if "turn_calibration" in meta and all("turn_scores" in v for v in views):
             places = np.array(meta["turn_calibration"]["positions"])
             place_scores = np.array(meta["turn_calibration"]["scores"])
-            turn_model = calibrate(spots, places, place_scores)
+            turn_model = calibrate_goodness(spots, places, place_scores)
             turns = np.array([v["turn_scores"] for v in views])
             estimates["turn_calibrated"] = _stacked(
-                [locate_calibrated(s, spots, turn_model, bounds) for s in turns]
+                [locate_by_goodness(s, spots, turn_model, bounds) for s in turns]
             )
             estimates["turn_nearest"] = _stacked(
-                [locate_nearest(s, places, place_scores, turn_model[2]) for s in turns]
+                [locate_by_turn_signature(s, places, place_scores, turn_model.sigma) for s in turns]
             )
             results["turn_calibration"] = {
-                "sigma": turn_model[2].round(5).tolist(),
-                "length_m": turn_model[3],
+                "sigma": turn_model.sigma.round(5).tolist(),
+                "length_m": turn_model.length_m,
                 "places": len(places),
                 "nearest_k": NEAREST_K,
             }

@@ -32,19 +32,21 @@ from vc_gym.angles import wrap180
 from vc_gym.experiments.real_data import ROTATION_SETS, default_real_data_dir, load_rotation_set
 from vc_gym.experiments.real_rotation import rotation_set_errors
 from vc_gym.experiments.spot_sensors import fit_colours, room, teach
+from vc_gym.experiments.studies import get_experiment
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
+    check_scenes,
     median_timings,
     open_run,
     pick_size,
     scene_field_bounds,
 )
-from vc_gym.experiments.studies.homing import run_homing
-from vc_gym.experiments.studies.orientation import check_scenes, rear_half_centre
+from vc_gym.experiments.studies.orientation_grid import rear_half_centre
 from vc_gym.experiments.views import learning_turn, look
 from vc_gym.heading_sensors import NoisyMagneticCompass, make_sensor
+from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
-from vc_gym.jobs.runner import ExperimentRun, Job
+from vc_gym.jobs.run import ExperimentRun
 from vc_gym.sim.scenes import scene_names
 
 __all__ = [
@@ -60,7 +62,7 @@ __all__ = [
 #: (:func:`vc_gym.heading_sensors.make_sensor`).
 SENSORS: dict[str, Any] = {
     "visual_compass": "visual_compass",
-    "visual_compass_improved": {"type": "visual_compass", "exposure": "mean"},
+    "visual_compass_mean_exposure": {"type": "visual_compass", "exposure": "mean"},
     "image_difference": "image_difference",
     "sector_colour": "sector_colour",
     "feature": "feature",
@@ -304,6 +306,7 @@ def _homing(run: ExperimentRun, opts: ExperimentOptions, episodes: int) -> dict[
     atlas and kidnappings."""
     out: dict[str, Any] = {}
     atlas_dir = opts.atlas_dir
+    run_homing = get_experiment("homing").runner()
     for name in HOMING_SENSORS:
         sub = ExperimentOptions(
             seed=opts.seed,

@@ -19,21 +19,31 @@ from typing import Any
 import numpy as np
 
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
+from vc_gym.experiments.episode import (
+    DEFAULT_HOMING_MODE,
+    HOMING_MODES,
+    canonical_homing_mode,
+)
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     median_timings,
     open_run,
     pick_size,
 )
-from vc_gym.experiments.studies.homing import spread_over_seeds, summarise_stops
-from vc_gym.experiments.studies.orientation import (
+from vc_gym.experiments.studies.kidnapping import (
+    EPISODE_JOB,
+    spread_over_seeds,
+    summarise_stops,
+)
+from vc_gym.experiments.studies.orientation_grid import (
     DEFAULT_TRACKERS,
     check_trackers,
     orientation_stage,
 )
 from vc_gym.experiments.views import COMPASS
+from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
-from vc_gym.jobs.runner import ExperimentRun, Job
+from vc_gym.jobs.run import ExperimentRun
 
 __all__ = ["run_trackers", "summary_lines"]
 
@@ -72,6 +82,7 @@ def run_trackers(
     scenes: Sequence[str] | None = None,
     seeds: Sequence[int] | None = None,
     episodes: int | None = None,
+    mode: str = DEFAULT_HOMING_MODE,
 ) -> dict[str, Any]:
     """Benchmark trackers on the homing task and the orientation grid.
 
@@ -89,6 +100,9 @@ def run_trackers(
         Learning seeds (default by size, from ``opts.seed`` on).
     episodes : int, optional
         Kidnappings per (scene, seed, tracker).
+    mode : str
+        The homing mode (:data:`~vc_gym.experiments.episode.HOMING_MODES`):
+        ``"check-home"`` (default) or ``"paper"``.
 
     Returns
     -------
@@ -108,10 +122,13 @@ def run_trackers(
     episodes = size["episodes"] if episodes is None else int(episodes)
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
+    mode = canonical_homing_mode(mode)
     settings = {"trackers": named, "scenes": scenes, "seeds": seeds, "episodes": episodes}
+    if mode != "paper":  # a paper-mode run's settings (and so its jobs) stay as they were
+        settings["mode"] = mode
     run = open_run(out_dir, "trackers", opts, settings)
 
-    homing = _homing(run, opts, size, named, scenes, seeds, episodes)
+    homing = _homing(run, opts, size, named, scenes, seeds, episodes, mode)
     views: dict[str, Any] = {}
     for scene in scenes:
         _, summary, spot, _ = orientation_stage(
@@ -166,9 +183,12 @@ def run_trackers(
     return run.finish(results, {"ms_per_update_median": costs})
 
 
-def _homing(run: ExperimentRun, opts, size, named, scenes, seeds, episodes):
+def _homing(run: ExperimentRun, opts, size, named, scenes, seeds, episodes, mode):
+    learning = HOMING_MODES[mode].learning
     specs = {
-        (sc, s): atlas_spec(sc, s, "scripted", size["learn_time_s"]) for sc in scenes for s in seeds
+        (sc, s): atlas_spec(sc, s, "scripted", size["learn_time_s"], learning=learning)
+        for sc in scenes
+        for s in seeds
     }
     paths = ensure_atlases(run, list(specs.values()), opts.atlas_dir)
     jobs, where = [], []
@@ -185,13 +205,14 @@ def _homing(run: ExperimentRun, opts, size, named, scenes, seeds, episodes):
                     "atlas": paths[atlas_key(aspec)],
                     "learning_seed": s,
                     "episode_seed": s + 1 + i,
+                    **({"mode": mode} if mode != "paper" else {}),
                 }
                 if len(jobs) < opts.video:
                     folder = run.out / "videos"
                     folder.mkdir(exist_ok=True)
                     kwargs["video"] = str((folder / f"{len(jobs):03d}.mp4").resolve())
                 key = f"{_safe(name)}-{sc}-seed{s}-episode{i:03d}"
-                jobs.append(Job(key, "vc_gym.experiments.studies.homing:episode_job", kwargs))
+                jobs.append(Job(key, EPISODE_JOB, kwargs))
                 where.append((name, sc))
     out: dict[str, dict[str, list]] = {n: {sc: [] for sc in scenes} for n in named}
     for (name, sc), o in zip(where, run.run("episodes", jobs), strict=True):

@@ -26,18 +26,30 @@ Your own scene
 Register a builder function under a new name with :func:`register_scene`; from then on
 the name works wherever a built-in scene name does (``gym.make(..., scene=name)`` for
 ``vc_gym/AiboRoom-v0`` and ``vc_gym/LearnThenHome-v0``, :func:`build_scene`). The builder
-gets a :class:`~vc_gym.sim.scenes.base.Builder`, creates the scene's bodies through it
-(the toolkit is in :mod:`vc_gym.sim.scenes.base` and
-:mod:`vc_gym.sim.scenes.furniture`, textures are painted with
-:class:`vc_gym.sim.textures.Canvas`) and returns ``(room_bounds, field_bounds,
-light_direction)``. A small box room with four coloured walls and a poster::
+gets a :class:`Builder`, creates the scene's bodies through it and returns
+``(room_bounds, field_bounds, light_direction)``. The toolkit, exported here too:
+
+* :mod:`~vc_gym.sim.scenes.builder`: :class:`Builder` makes textured quads
+  (:meth:`Builder.mesh`), furniture (:meth:`Builder.solid`) and invisible walls
+  (:meth:`Builder.fence`); its :attr:`Builder.choices` (a :class:`Draw`, in
+  :mod:`~vc_gym.sim.scenes.choices`) gives each layout choice its canonical value, or a
+  random one when the scene is built with ``randomize=True``;
+* :mod:`~vc_gym.sim.scenes.parts`: furniture shapes :class:`Part` (:func:`box`,
+  :func:`cyl`, :func:`ball`);
+* :mod:`~vc_gym.sim.scenes.rooms`: a :class:`Room` of four :class:`Wall` canvases,
+  built with its floor and ceiling;
+* :mod:`~vc_gym.sim.scenes.scene`: :class:`Scene` (a built scene) and
+  :class:`SceneLayout` (what a builder returns);
+* :mod:`vc_gym.sim.scenes.furniture`: doors, windows, pictures, desks, shelves...
+
+Textures are painted on a :class:`vc_gym.sim.textures.Canvas`. A small box room with
+four coloured walls and a poster::
 
     import gymnasium as gym
 
     import vc_gym  # registers the envs
     from vc_gym.sim import textures
-    from vc_gym.sim.scenes import register_scene
-    from vc_gym.sim.scenes.base import Room, SceneLayout
+    from vc_gym.sim.scenes import Room, SceneLayout, register_scene
     from vc_gym.sim.scenes.furniture import ceiling_texture, sun
 
 
@@ -45,8 +57,8 @@ light_direction)``. A small box room with four coloured walls and a poster::
     def my_room(b):
         bounds, field = (-2.5, 2.5, -2.0, 2.0), (-1.5, 1.5, -1.2, 1.2)  # xmin, xmax, ymin, ymax
         paint = {"E": (200, 40, 40), "N": (40, 160, 60), "W": (40, 70, 200), "S": (230, 200, 40)}
-        # b.var.colour gives the paint itself, or a nearby colour when randomize=True
-        room = Room(b, bounds, 2.5, {side: b.var.colour(rgb) for side, rgb in paint.items()})
+        # b.choices.colour gives the paint itself, or a nearby colour when randomize=True
+        room = Room(b, bounds, 2.5, {side: b.choices.colour(rgb) for side, rgb in paint.items()})
         poster = textures.procedural_poster(b.rng, (120, 90), "blocks")
         north = room.walls["N"]  # u runs left to right seen from inside, z up
         north.canvas.framed(1.5, 2.4, 0.5, 1.7, poster, (25, 25, 25), 0.04)
@@ -60,7 +72,7 @@ light_direction)``. A small box room with four coloured walls and a poster::
     env = gym.make("vc_gym/AiboRoom-v0", scene="my_room")
     obs, info = env.reset(seed=0)
 
-Take every random draw from ``b.rng`` or ``b.var`` (never ``np.random``): the canonical
+Take every random draw from ``b.rng`` or ``b.choices`` (never ``np.random``): the canonical
 scene is then built from ``canonical_seed`` and is always the same, and a randomised one
 is the same for the same seed. Keep ``field_bounds`` (where the robot is placed and
 kidnapped to) at least 0.2 m from walls and furniture; ``vc_gym/LearnThenHome-v0`` puts
@@ -89,7 +101,9 @@ does not import it in its workers.
 
 import importlib
 
-from vc_gym.sim.scenes.base import Scene, SceneLayout
+from vc_gym.sim.scenes.builder import Builder, Quad
+from vc_gym.sim.scenes.choices import Draw
+from vc_gym.sim.scenes.parts import RGB, Part, ball, box, cyl
 from vc_gym.sim.scenes.registry import (
     build_scene,
     check_scene_name,
@@ -97,6 +111,8 @@ from vc_gym.sim.scenes.registry import (
     scene_names,
     unregister_scene,
 )
+from vc_gym.sim.scenes.rooms import FLOOR_PPM, WALL_PPM, Room, Wall
+from vc_gym.sim.scenes.scene import Scene, SceneLayout
 
 #: Names of the BUILT-IN scenes, kept for backwards compatibility. Scenes registered
 #: later are not in it: use :func:`scene_names` for every registered scene.
@@ -109,11 +125,23 @@ for _module in SCENES:
 del _module
 
 __all__ = [
+    "FLOOR_PPM",
+    "RGB",
     "SCENES",
+    "WALL_PPM",
+    "Builder",
+    "Draw",
+    "Part",
+    "Quad",
+    "Room",
     "Scene",
     "SceneLayout",
+    "Wall",
+    "ball",
+    "box",
     "build_scene",
     "check_scene_name",
+    "cyl",
     "register_scene",
     "scene_names",
     "unregister_scene",

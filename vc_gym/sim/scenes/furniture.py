@@ -1,13 +1,13 @@
-"""Furniture and wall decorations for rooms made with :class:`~vc_gym.sim.scenes.base.Room`.
+"""Furniture and wall decorations for rooms made with :class:`~vc_gym.sim.scenes.rooms.Room`.
 
 Wall decorations (:func:`hang_pictures`, :func:`door`, :func:`window`, :func:`baseboard`)
-are painted on a :class:`~vc_gym.sim.scenes.base.Wall`'s canvas and take their area;
+are painted on a :class:`~vc_gym.sim.scenes.rooms.Wall`'s canvas and take their area;
 furniture (:func:`workstation`, :func:`chair`, :func:`shelf`, :func:`cabinet`,
 :func:`plant`, :func:`sofa`, :func:`floor_lamp`) is built from parts placed along a wall:
 ``side`` is the wall (``"E"``, ``"N"``, ``"W"``, ``"S"``), ``u`` the position along it
 seen from inside (left to right) and ``d`` the distance out of it, in metres. Colours
 are RGB 0..255; every random draw comes from the builder's generator (``b.rng``) or its
-layout choices (``b.var``).
+layout choices (``b.choices``).
 """
 
 from __future__ import annotations
@@ -17,7 +17,9 @@ import math
 import numpy as np
 
 from vc_gym.sim import textures as tx
-from vc_gym.sim.scenes.base import RGB, Builder, Part, Room, Wall
+from vc_gym.sim.scenes.builder import Builder
+from vc_gym.sim.scenes.parts import RGB, Part
+from vc_gym.sim.scenes.rooms import Room, Wall
 
 __all__ = [
     "baseboard",
@@ -126,7 +128,7 @@ def door(b: Builder, wall: Wall, u0: float, width: float = 0.9) -> None:
     Parameters
     ----------
     b : Builder
-        The scene's builder (colours from ``b.var``).
+        The scene's builder (colours from ``b.choices``).
     wall : Wall
         The wall.
     u0 : float
@@ -134,7 +136,7 @@ def door(b: Builder, wall: Wall, u0: float, width: float = 0.9) -> None:
     width : float
         Width of the door (m).
     """
-    v = b.var
+    v = b.choices
     leaf = v.colour((150, 105, 65), dh=0.5, ds=0.4, dv=0.3)
     casing = v.colour((238, 236, 230), dh=0.1, ds=0.05, dv=0.08)
     wall.canvas.door(u0, u0 + width, 2.05, leaf, casing)
@@ -193,7 +195,7 @@ def ceiling_texture(b: Builder, bounds, panels: bool = True) -> np.ndarray:
     Parameters
     ----------
     b : Builder
-        The scene's builder (the colour comes from ``b.var``).
+        The scene's builder (the colour comes from ``b.choices``).
     bounds : tuple of float
         ``(xmin, xmax, ymin, ymax)`` of the room.
     panels : bool
@@ -206,7 +208,7 @@ def ceiling_texture(b: Builder, bounds, panels: bool = True) -> np.ndarray:
     """
     x0, x1, y0, y1 = bounds
     # the ceiling's texture u runs along y, v along x (see Room.build)
-    c = tx.Canvas(y1 - y0, x1 - x0, 32.0, b.var.colour((240, 240, 236), dv=0.05))
+    c = tx.Canvas(y1 - y0, x1 - x0, 32.0, b.choices.colour((240, 240, 236), dv=0.05))
     if panels:
         for u in np.arange(0.9, y1 - y0 - 0.9, 1.8):
             for v in np.arange(0.9, x1 - x0 - 1.2, 2.4):
@@ -236,7 +238,7 @@ def workstation(b: Builder, room: Room, side: str, u0: float, width: float = 1.6
     width : float
         The table's length (m); below 1.4 m it holds one monitor in the canonical scene.
     """
-    v, rng = b.var, b.rng
+    v, rng = b.choices, b.rng
     depth, top = 0.75, 0.74
     wood = v.colour((200, 170, 125), dh=0.05, ds=0.2, dv=0.2)
     leg = v.colour((90, 90, 95), dv=0.2)
@@ -285,7 +287,7 @@ def chair(b: Builder, room: Room, side: str, uc: float, d0: float) -> None:
     d0 : float
         Distance of its front from the wall (m).
     """
-    v = b.var
+    v = b.choices
     seat = v.colour((45, 70, 150), dh=0.5, ds=0.3, dv=0.3)
     dark = (35, 35, 38)
     dc = d0 + 0.25
@@ -519,7 +521,7 @@ def sun(b: Builder, canonical: tuple[float, float, float]) -> tuple[float, float
     tuple of float
         Unit vector towards the light.
     """
-    if b.var.on:
+    if b.choices.randomize:
         az = b.rng.uniform(0.0, 2.0 * math.pi)
         el = b.rng.uniform(math.radians(35.0), math.radians(75.0))
         vec = (math.cos(az) * math.cos(el), math.sin(az) * math.cos(el), math.sin(el))
@@ -545,8 +547,8 @@ def wall_colours(b: Builder, canonical: RGB) -> dict[str, np.ndarray]:
         Paint per side (``"E"``, ``"N"``, ``"W"``, ``"S"``) for :class:`Room`; replace an
         entry to paint one wall differently.
     """
-    v = b.var
-    if v.on:
+    v = b.choices
+    if v.randomize:
         if b.rng.uniform() < 0.6:
             base = tx.hsv(b.rng.uniform(), b.rng.uniform(0.02, 0.2), b.rng.uniform(0.82, 0.95))
         else:

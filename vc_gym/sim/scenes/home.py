@@ -7,7 +7,7 @@ floor lamp, curtains, paintings.
 from __future__ import annotations
 
 from vc_gym.sim import textures as tx
-from vc_gym.sim.scenes.base import FLOOR_PPM, Builder, Room, SceneLayout
+from vc_gym.sim.scenes.builder import Builder
 from vc_gym.sim.scenes.furniture import (
     baseboard,
     cabinet,
@@ -23,6 +23,8 @@ from vc_gym.sim.scenes.furniture import (
     window,
 )
 from vc_gym.sim.scenes.registry import register_scene
+from vc_gym.sim.scenes.rooms import FLOOR_PPM, Room
+from vc_gym.sim.scenes.scene import SceneLayout
 
 __all__ = ["build_home"]
 
@@ -30,10 +32,10 @@ __all__ = ["build_home"]
 @register_scene("home", canonical_seed=2007)
 def build_home(b: Builder) -> SceneLayout:
     """Build the home scene (see the module docstring) with ``b``."""
-    v, rng = b.var, b.rng
+    v, rng = b.choices, b.rng
     bounds, field_b, height = (-2.75, 2.75, -2.4, 2.4), (-1.5, 1.5, -1.2, 1.2), 2.6
     colours = wall_colours(b, (236, 218, 186))
-    if v.on and rng.uniform() < 0.5:  # warm paints in randomised homes
+    if v.randomize and rng.uniform() < 0.5:  # warm paints in randomised homes
         colours = {
             s: tx.hsv(rng.uniform(0.0, 0.15), rng.uniform(0.15, 0.45), rng.uniform(0.7, 0.92))
             for s in "ENWS"

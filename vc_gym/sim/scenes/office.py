@@ -8,7 +8,7 @@ ceiling with light panels.
 from __future__ import annotations
 
 from vc_gym.sim import textures as tx
-from vc_gym.sim.scenes.base import FLOOR_PPM, Builder, Room, SceneLayout
+from vc_gym.sim.scenes.builder import Builder
 from vc_gym.sim.scenes.furniture import (
     baseboard,
     cabinet,
@@ -23,6 +23,8 @@ from vc_gym.sim.scenes.furniture import (
     workstation,
 )
 from vc_gym.sim.scenes.registry import register_scene
+from vc_gym.sim.scenes.rooms import FLOOR_PPM, Room
+from vc_gym.sim.scenes.scene import SceneLayout
 
 __all__ = ["build_office"]
 
@@ -30,7 +32,7 @@ __all__ = ["build_office"]
 @register_scene("office", canonical_seed=16)
 def build_office(b: Builder) -> SceneLayout:
     """Build the office scene (see the module docstring) with ``b``."""
-    v, rng = b.var, b.rng
+    v, rng = b.choices, b.rng
     bounds, field_b, height = (-3.0, 3.0, -2.5, 2.5), (-2.0, 2.0, -1.0, 1.0), 2.7
     colours = wall_colours(b, (240, 240, 236))
     accent = v.choice("W", ("E", "N", "W", "S"))
@@ -64,7 +66,7 @@ def build_office(b: Builder) -> SceneLayout:
     # windows with blinds, filing cabinets and a plant
     win = room.walls[window_side]
     blinds = v.colour((215, 215, 210), dh=0.5, ds=0.3, dv=0.1)
-    for uc in (1.6, 4.4) if not v.on else sorted(rng.uniform(1.2, 4.8, 2)):
+    for uc in (1.6, 4.4) if not v.randomize else sorted(rng.uniform(1.2, 4.8, 2)):
         if win.free(uc - 0.75, uc + 0.75, 0.8, 2.3, 0.05):
             window(b, win, uc - 0.75, uc + 0.75, 0.8, 2.3, blinds=blinds)
     cab_rgb = v.colour((120, 125, 135), dh=0.5, ds=0.3, dv=0.2)

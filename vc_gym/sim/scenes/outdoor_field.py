@@ -13,9 +13,11 @@ import math
 import numpy as np
 
 from vc_gym.sim import textures as tx
-from vc_gym.sim.scenes.base import RGB, Builder, SceneLayout, ball, box, cyl
+from vc_gym.sim.scenes.builder import Builder
 from vc_gym.sim.scenes.furniture import sun
+from vc_gym.sim.scenes.parts import RGB, ball, box, cyl
 from vc_gym.sim.scenes.registry import register_scene
+from vc_gym.sim.scenes.scene import SceneLayout
 
 __all__ = ["build_outdoor_field"]
 
@@ -23,7 +25,7 @@ __all__ = ["build_outdoor_field"]
 @register_scene("outdoor_field", canonical_seed=5)
 def build_outdoor_field(b: Builder) -> SceneLayout:
     """Build the outdoor_field scene (see the module docstring) with ``b``."""
-    v, rng = b.var, b.rng
+    v, rng = b.choices, b.rng
     reach, field_b = (-7.0, 7.0, -5.0, 5.0), (-3.0, 3.0, -2.0, 2.0)
     radius, sky_h, ground = 34.0, 22.0, 35.0
 
@@ -182,7 +184,8 @@ def _grandstand(b: Builder, side: float, seat: RGB) -> None:
         colour = seat if s % 2 == 0 else seat * np.float32(0.8)
         parts.append(box(-12.0, 12.0, y0, y1, 0.5 + s * 0.5, 0.8 + s * 0.5, colour))
     parts.append(box(-12.2, 12.2, *ys(4.0, 4.3), 0.0, 4.2, grey))
-    parts.append(box(-12.5, 12.5, *ys(-0.5, 4.3), 4.2, 4.5, b.var.colour((180, 40, 40), dh=0.5)))
+    roof = b.choices.colour((180, 40, 40), dh=0.5)
+    parts.append(box(-12.5, 12.5, *ys(-0.5, 4.3), 4.2, 4.5, roof))
     for xp in (-12.0, 0.0, 12.0):
         parts.append(box(xp - 0.1, xp + 0.1, *ys(-0.4, -0.2), 0.0, 4.2, grey))
     b.solid(parts)

@@ -17,7 +17,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from vc_gym.sim.scenes.base import Builder, Scene, SceneLayout
+from vc_gym.sim.scenes.builder import Builder
+from vc_gym.sim.scenes.scene import Scene, SceneLayout
 
 __all__ = [
     "build_scene",
@@ -106,12 +107,12 @@ def register_scene(
     """Decorator that registers a scene builder under ``name``.
 
     The builder is called as ``fn(builder)`` with a fresh
-    :class:`~vc_gym.sim.scenes.base.Builder` and creates every body of the scene
+    :class:`~vc_gym.sim.scenes.builder.Builder` and creates every body of the scene
     through it (``builder.mesh``, ``builder.solid``, ``builder.fence``, or a
-    :class:`~vc_gym.sim.scenes.base.Room`). It returns
+    :class:`~vc_gym.sim.scenes.rooms.Room`). It returns
     ``(room_bounds, field_bounds, light_direction)``, a
-    :class:`~vc_gym.sim.scenes.base.SceneLayout` or a plain tuple in that order.
-    It must take every random draw from ``builder.rng`` or ``builder.var`` so that the
+    :class:`~vc_gym.sim.scenes.scene.SceneLayout` or a plain tuple in that order.
+    It must take every random draw from ``builder.rng`` or ``builder.choices`` so that the
     same generator state gives the same scene.
 
     Parameters

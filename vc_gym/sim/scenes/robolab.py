@@ -10,7 +10,7 @@ matplotlib's sample data, maps and procedural posters) on the walls, and a close
 from __future__ import annotations
 
 from vc_gym.sim import textures as tx
-from vc_gym.sim.scenes.base import FLOOR_PPM, RGB, Builder, Room, SceneLayout, box
+from vc_gym.sim.scenes.builder import Builder
 from vc_gym.sim.scenes.furniture import (
     baseboard,
     cabinet,
@@ -23,7 +23,10 @@ from vc_gym.sim.scenes.furniture import (
     window,
     workstation,
 )
+from vc_gym.sim.scenes.parts import RGB, box
 from vc_gym.sim.scenes.registry import register_scene
+from vc_gym.sim.scenes.rooms import FLOOR_PPM, Room
+from vc_gym.sim.scenes.scene import SceneLayout
 
 __all__ = ["build_robolab"]
 
@@ -50,7 +53,7 @@ def _goal(b: Builder, x_mouth: float, sign: float, rgb: RGB) -> None:
 @register_scene("robolab", canonical_seed=2006)
 def build_robolab(b: Builder) -> SceneLayout:
     """Build the robolab scene (see the module docstring) with ``b``."""
-    v, rng = b.var, b.rng
+    v, rng = b.choices, b.rng
     bounds, field_b, height = (-3.5, 3.5, -3.5, 3.5), (-3.0, 3.0, -2.0, 2.0), 2.8
     colours = wall_colours(b, (232, 228, 212))
     desk_side = v.choice("N", ("N", "S"))
@@ -90,7 +93,7 @@ def build_robolab(b: Builder) -> SceneLayout:
     cab = cabinet(b, room, window_side, 5.85, 1.0, 0.75, v.colour((200, 200, 195)))
     crates = [(210, 40, 40), (40, 90, 200), (240, 200, 30)]
     for k in range(2):
-        c = crates[int(rng.integers(3))] if v.on else crates[k]
+        c = crates[int(rng.integers(3))] if v.randomize else crates[k]
         ua = 5.9 + k * 0.48
         cab.append(room.box(window_side, ua, ua + 0.44, 0.05, 0.4, 0.75, 1.02, c))
     b.solid(cab)

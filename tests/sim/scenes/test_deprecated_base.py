@@ -1,0 +1,31 @@
+"""vc_gym.sim.scenes.base is a deprecated alias: each name warns and is the moved object."""
+
+from __future__ import annotations
+
+import pytest
+
+import vc_gym.sim.scenes as scenes
+from vc_gym.sim.scenes import base
+
+NAMES = [
+    "FLOOR_PPM", "RGB", "WALL_PPM", "Builder", "Draw", "Part", "Quad", "Room", "Scene",
+    "SceneLayout", "Wall", "ball", "box", "cyl",
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_each_old_name_warns_and_returns_the_same_object(name):
+    with pytest.warns(DeprecationWarning, match=f"import {name} from vc_gym.sim.scenes"):
+        old = getattr(base, name)
+    assert old is getattr(scenes, name)
+
+
+def test_from_import_warns_too():
+    with pytest.warns(DeprecationWarning, match="vc_gym.sim.scenes.base is deprecated"):
+        from vc_gym.sim.scenes.base import Room
+    assert Room is scenes.Room
+
+
+def test_unknown_names_are_attribute_errors():
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        base.nothing  # noqa: B018

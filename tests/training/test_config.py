@@ -1,0 +1,146 @@
+"""The configuration of a training run: fields checked, saved and read back, settings files."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import gymnasium as gym
+import pytest
+from tiny_configs import TINY
+
+from vc_gym.training.config import TrainConfig, read_train_config
+
+
+def test_config_file_and_command_line(tmp_path):
+    cfg = tmp_path / "ppo.yml"
+    cfg.write_text("algo: ppo\nnet_arch: [32, 32]\nlearning_rate: 0.001\nscene: office\n")
+    config = read_train_config(cfg, timesteps=500)
+    assert config.net_arch == (32, 32) and config.learning_rate == 0.001
+    assert config.scene == "office" and config.timesteps == 500 and config.gamma == 0.99
+    # fields a settings file leaves out take today's defaults (a saved config.json's
+    # take the values of its era, test_stops_are_checked_in_training...)
+    assert config.confirm_stop_m == 0.25 and config.collector == "async"
+    # a run's own config.json reads back as the same config
+    saved = tmp_path / "config.json"
+    saved.write_text(json.dumps(TINY.to_dict()))
+    assert read_train_config(saved) == TINY
+    bad = tmp_path / "bad.yml"
+    bad.write_text("reward: 3\n")
+    with pytest.raises(ValueError, match="bad.yml.*unknown"):
+        read_train_config(bad)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"algo": "dqn"},
+        {"timesteps": 0},
+        {"n_envs": 1.5},
+        {"gamma": 1.5},
+        {"net_arch": (0,)},
+        {"vec_env": "ray"},
+        {"learning_rate": float("nan")},
+        {"demo_episodes": -1},
+        {"algo": "sac", "demo_episodes": 5},
+        {"confirm_stop_m": 0.0},
+        {"confirm_stop_m": float("inf")},
+        {"closeness_bonus": -1.0},
+        {"closeness_bonus": float("nan")},
+        {"min_walk_m": -0.5},
+    ],
+)
+def test_bad_train_config(kwargs):
+    with pytest.raises(ValueError):
+        TrainConfig(**kwargs)
+
+
+def test_config_file_round_trip_and_errors(tmp_path):
+    assert TrainConfig.from_dict(TINY.to_dict()) == TINY
+    with pytest.raises(ValueError, match="unknown"):
+        TrainConfig.from_dict({**TINY.to_dict(), "reward": 3})
+    with pytest.raises(ValueError, match="schema"):
+        TrainConfig.from_dict({**TINY.to_dict(), "schema": 99})
+    with pytest.raises(ValueError, match="does not match"):
+        TrainConfig.from_dict({**TINY.to_dict(), "env": {"scene": "office"}})
+    schema1 = {k: v for k, v in TINY.to_dict().items() if k not in ("env", "tracker")}
+    assert TrainConfig.from_dict({**schema1, "schema": 1}) == TINY
+
+
+def test_stops_are_checked_in_training_and_old_configs_keep_their_final_stops():
+    assert TrainConfig().confirm_stop_m == 0.25 and TrainConfig().stop_time_s == 5.0
+    assert TINY.env_kwargs()["confirm_stop_m"] == 0.25
+    assert TrainConfig.from_dict(TINY.to_dict()) == TINY
+    final = replace(TINY, confirm_stop_m=None)
+    assert "confirm_stop_m" not in final.env_kwargs()
+    assert TrainConfig.from_dict(final.to_dict()) == final
+    # a config.json written before the field existed: its stops were final
+    saved_before = {k: v for k, v in final.to_dict().items() if k != "confirm_stop_m"}
+    assert TrainConfig.from_dict(saved_before) == final
+
+
+@pytest.mark.parametrize(("name", "value"), [("closeness_bonus", 10.0), ("min_walk_m", 0.5)])
+def test_optional_env_settings_and_old_configs_without_them(name, value):
+    assert getattr(TrainConfig(), name) == 0.0
+    given = replace(TINY, **{name: value})
+    assert given.env_kwargs()[name] == value
+    assert TrainConfig.from_dict(given.to_dict()) == given
+    plain = replace(TINY, **{name: 0.0})
+    assert name not in plain.env_kwargs()
+    assert TrainConfig.from_dict(plain.to_dict()) == plain
+    # a config.json written before the field existed: trained without it
+    saved_before = {k: v for k, v in plain.to_dict().items() if k != name}
+    assert TrainConfig.from_dict(saved_before) == plain
+    # what the agent's env is built with
+    env = gym.make("vc_gym/Homing-v0", **given.env_kwargs())
+    assert env.get_wrapper_attr(name) == value
+    env.close()
+
+
+def test_places_are_checked_and_saved():
+    assert TINY.place_seeds == (0,) and TINY.places == ()
+    config = replace(TINY, places=[3, 1])
+    assert config.places == (3, 1) and config.place_seeds == (3, 1)
+    assert TrainConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
+    assert [p.name for p in config.atlas_files("run")] == [
+        "atlas-place3.npz",
+        "atlas-place1.npz",
+    ]
+    for bad in ([1, 1], [-1], "12", [0.5], 3, list(range(17))):
+        with pytest.raises(ValueError, match="places"):
+            replace(TINY, places=bad)
+
+
+def test_goal_correction_settings():
+    # the default goal is measured and centred (README, Learned agents: learning seeds 30-32)
+    assert TrainConfig().home_offset_episodes == 10 and TrainConfig().home_offset_places == 3
+    assert TrainConfig().home_offset_centre is True and TrainConfig().home_offset_m is None
+    assert "home_offset_m" not in TrainConfig(seed=0).env_kwargs()  # until it is measured
+    assert TrainConfig(seed=2).home_offset_seeds == (2, 2_000_032, 2_000_033, 2_000_034)
+    given = replace(TINY, home_offset_m=(0.05, -0.1))
+    assert given.env_kwargs()["home_offset_m"] == [0.05, -0.1]
+    assert TrainConfig.from_dict(json.loads(json.dumps(given.to_dict()))) == given
+    assert "home_offset_m" not in TINY.env_kwargs()
+    # a config.json written before the fields existed: trained towards the tracker's home
+    saved_before = {
+        k: v for k, v in TrainConfig().to_dict().items() if not k.startswith("home_offset")
+    }
+    old = TrainConfig.from_dict(saved_before)
+    assert old.home_offset_episodes == 0 and old.home_offset_m is None
+    assert old.home_offset_centre is False
+    centred = replace(TINY, home_offset_episodes=10, home_offset_centre=True)
+    assert TrainConfig.from_dict(json.loads(json.dumps(centred.to_dict()))) == centred
+    for bad in (
+        {"home_offset_episodes": -1},
+        {"home_offset_places": 17},
+        {"home_offset_episodes": 1, "home_offset_places": 0},  # 1 episode: too few
+        {"home_offset_m": (2.0, 0.0)},
+        {"home_offset_m": (float("nan"), 0.0)},
+        {"home_offset_m": (0.1,)},
+        {"home_offset_m": "0.1,0.2"},
+        {"home_offset_centre": "yes"},
+        {"home_offset_centre": 1},
+        {"home_offset_episodes": 0},  # nothing measured to centre (centring is the default)
+    ):
+        with pytest.raises(ValueError, match="home_offset"):
+            TrainConfig(**bad)

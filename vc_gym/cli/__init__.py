@@ -1,0 +1,79 @@
+"""The ``vc-gym`` command: one module per sub-command, each adding its parser.
+
+Every command module has ``add_parser(commands)``, which registers its sub-command
+with ``func`` (the function that runs it) and, where an interrupted run can go on,
+``hint`` (what to tell the user after Ctrl-C).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from vc_gym.cli import bench, check, demo, evaluate, experiment, render, soak, train
+from vc_gym.cli.bench import MAX_BENCH_REPEATS
+from vc_gym.experiments.options import MAX_VIDEOS
+
+__all__ = [
+    "COMMANDS",
+    "EXIT_INTERRUPTED",
+    "MAX_BENCH_REPEATS",
+    "MAX_VIDEOS",
+    "build_parser",
+    "main",
+]
+
+#: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+#: The command modules, in the order ``vc-gym --help`` lists them.
+COMMANDS = (demo, bench, evaluate, train, render, soak, check, experiment)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``vc-gym`` (exposed for documentation and tests)."""
+    from vc_gym import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="vc-gym",
+        description=(
+            "vc_gym: the appearance-based visual compass of Sturm & Visser - compass "
+            "sensor, filters, simulated quadruped room and homing agents."
+        ),
+    )
+    parser.add_argument("--version", action="version", version=f"vc_gym {__version__}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for command in COMMANDS:
+        command.add_parser(commands)
+    _remember_parsers(parser)
+    return parser
+
+
+def _remember_parsers(parser: argparse.ArgumentParser) -> None:
+    """Let every (sub-)command's namespace know its own parser, so that an unknown flag
+    is reported with that command's usage, not the top level's."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                sub.set_defaults(parser=sub)
+                _remember_parsers(sub)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``vc-gym``; returns the exit status."""
+    parser = build_parser()
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:
+        getattr(args, "parser", parser).error(f"unrecognized arguments: {' '.join(unknown)}")
+    try:
+        return int(args.func(args))
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
+        hint = args.hint(args) if getattr(args, "hint", None) else ""
+        print(f"vc-gym {args.command}: interrupted{hint}", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except (ValueError, FileNotFoundError) as e:
+        print(f"vc-gym {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except RuntimeError as e:  # a failure during the work (a dead worker, a fall, ...)
+        print(f"vc-gym {args.command}: failed: {e}", file=sys.stderr)
+        return 1
