@@ -75,6 +75,7 @@ def test_real_rotation_without_any_photo_folder_says_where_to_put_them(
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_demo_runs_the_main_job(tmp_path, capsys):
     assert main(["demo", "--out", str(tmp_path), "--learn-time", "0.3", "--seed", "1"]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())

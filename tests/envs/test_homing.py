@@ -14,6 +14,7 @@ from vc_gym.envs.homing import HomingFeatures, StopAction
 FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0}
 
 
+@pytest.mark.slow
 def test_spaces_and_wrapper_chain():
     env = gym.make("vc_gym/Homing-v0", **FAST)
     assert env.observation_space.shape == (12,) and env.action_space.shape == (3,)
@@ -27,6 +28,7 @@ def test_spaces_and_wrapper_chain():
     env.close()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tracker", ["grid", "particle", "kalman"])
 def test_trackers_plug_in_by_name(tracker):
     env = gym.make("vc_gym/Homing-v0", tracker=tracker, **FAST)
@@ -38,6 +40,7 @@ def test_trackers_plug_in_by_name(tracker):
     env.close()
 
 
+@pytest.mark.slow
 def test_make_vec_and_sb3_make_vec_env_build_the_same_env():
     sb3_env_util = pytest.importorskip("stable_baselines3.common.env_util")
     a = gym.make("vc_gym/Homing-v0", **FAST)
@@ -59,6 +62,7 @@ def test_features_need_compass_observations():
         StopAction(gym.make("CartPole-v1"))
 
 
+@pytest.mark.slow
 def test_stop_action_holds_still_until_the_task_stops():
     env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=1.0)
     assert env.action_space.shape == (3,)
@@ -88,6 +92,7 @@ def test_stop_action_holds_still_until_the_task_stops():
     env.close()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("walk", [[0.0, 0.0, 0.0], [-1.0, 0.02, -1.0], [-0.5, -0.01, 0.4]])
 def test_only_the_stop_output_ends_an_episode(walk):
     # a walk decision too small to move used to count as standing still, so the task's
@@ -100,6 +105,7 @@ def test_only_the_stop_output_ends_an_episode(walk):
     env.close()
 
 
+@pytest.mark.slow
 def test_a_confirmed_stop_is_called_off_when_the_estimate_leaves_home():
     env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=1.0, confirm_stop_m=0.25)
     stop_wrapper = env
@@ -127,6 +133,7 @@ def test_confirm_stop_must_be_a_positive_distance(bad):
         gym.make("vc_gym/Homing-v0", learn_time_s=0.2, confirm_stop_m=bad)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("head_scan", [True, False])
 def test_the_head_scans_when_the_robot_does_not_walk_forward(head_scan):
     env = gym.make("vc_gym/Homing-v0", head_scan=head_scan, **FAST)
@@ -150,6 +157,7 @@ def test_head_scan_must_be_a_bool():
         gym.make("vc_gym/Homing-v0", head_scan="yes", **FAST)
 
 
+@pytest.mark.slow
 def test_stop_requests_wait_until_the_robot_has_walked_min_walk_m():
     env = gym.make("vc_gym/Homing-v0", min_walk_s=0.0, min_walk_m=0.18, stop_time_s=1.0, **FAST)
     env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
@@ -172,6 +180,7 @@ def test_stop_requests_wait_until_the_robot_has_walked_min_walk_m():
         gym.make("vc_gym/Homing-v0", min_walk_m=-0.1, **FAST)
 
 
+@pytest.mark.slow
 def test_home_offset_moves_the_goal_of_the_features():
     offset = (0.1, -0.2)
     plain = gym.make("vc_gym/Homing-v0", **FAST)
@@ -205,6 +214,7 @@ def test_home_offset_must_be_a_nearby_point(bad):
         gym.make("vc_gym/Homing-v0", home_offset_m=bad, **FAST)
 
 
+@pytest.mark.slow
 def test_previous_action_appends_the_last_action_taken():
     from gymnasium.utils.env_checker import check_env
     from stable_baselines3.common.env_checker import check_env as sb3_check_env

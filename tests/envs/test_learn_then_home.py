@@ -25,6 +25,7 @@ def env():
     e.close()
 
 
+@pytest.mark.slow
 def test_reset_learns_an_atlas_and_kidnaps(env):
     obs, info = env.reset(seed=1)
     u = env.unwrapped
@@ -86,6 +87,7 @@ def test_a_learner_must_return_a_learning_result():
         gym.make("vc_gym/LearnThenHome-v0", learner="scripted")
 
 
+@pytest.mark.slow
 def test_progress_reward_is_distance_gained(env):
     env.reset(seed=2, options={"pose": (2.0, 0.0, 180.0)})  # facing home, 2 m away
     total = 0.0
@@ -149,6 +151,7 @@ def test_moving_resets_the_stop_clock_and_time_limit_truncates(learner):
     e.close()
 
 
+@pytest.mark.slow
 def test_scripted_homing_ends_at_home():
     """A short scripted episode on a fixed seed ends within the success radius."""
     e = gym.make("vc_gym/LearnThenHome-v0", learn_time_s=1.0)

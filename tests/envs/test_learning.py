@@ -110,6 +110,7 @@ def test_spot_learning_rejects_bad_spots(bad):
         SpotLearning(bad)
 
 
+@pytest.mark.slow
 def test_normalising_with_the_first_turn_puts_home_at_the_true_home():
     # "return" normalises where the odometry walk back ends (off the true home);
     # "start" uses the first turn's frames, taken at the true home: a frame from the
@@ -154,6 +155,7 @@ def test_grid_learning_shares_colours_and_knows_each_spot():
     env.close()
 
 
+@pytest.mark.slow
 def test_grid_learning_around_each_spot_adds_four_turns_to_its_map():
     env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
     room = env.unwrapped

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from vc_gym.cli import main
 from vc_gym.experiments.check import Case, all_cases, run_check
 
 
+@pytest.mark.slow
 def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
     out = tmp_path / "check.json"
     code = main(["check", "--soak-steps", "40", "--soak-cycles", "10", "--out", str(out)])

@@ -16,6 +16,7 @@ from vc_gym.jobs.backends import LocalBackend
 SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
 
 
+@pytest.mark.slow
 def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
     demo = run_demo(tmp_path, seed=2, progress=False, mode="check-home", **SHORT)
     # the experiment learns the place in a job, saves the atlas and homes with the
@@ -31,6 +32,7 @@ def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
     assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tracker", ["grid", "particle"])
 def test_record_holds_what_the_plots_need(tracker):
     run = make_homing_run(tracker=tracker, **SHORT)

@@ -33,6 +33,7 @@ def homing_quick(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ORDER)
 def test_every_experiment_wrote_its_files(paper_quick, name):
     folder = paper_quick / name
@@ -57,6 +58,7 @@ def test_every_experiment_is_tested_end_to_end():
     assert set(EXPERIMENTS) == expected
 
 
+@pytest.mark.slow
 def test_the_report_sets_our_figures_beside_the_papers(paper_quick):
     report = (paper_quick / "report.md").read_text()
     for claim in ("within 2 m", "(−22, +12) cm", "three colour classes", "1 %", "half"):
@@ -75,6 +77,7 @@ def test_the_report_sets_our_figures_beside_the_papers(paper_quick):
     assert learned == 0  # robolab's spot atlas and home atlas both came from the pool
 
 
+@pytest.mark.slow
 def test_orientation_reports_every_tracker_by_distance(paper_quick):
     r = json.loads((paper_quick / "orientation" / "results.json").read_text())
     robolab = r["scenes"]["robolab"]
@@ -84,6 +87,7 @@ def test_orientation_reports_every_tracker_by_distance(paper_quick):
         assert t["by_distance"] and sum(b["n"] for b in t["by_distance"]) == robolab["views"]
 
 
+@pytest.mark.slow
 def test_sensors_compares_every_sensor_on_the_same_views(paper_quick):
     from vc_gym.experiments.real_data import default_real_data_dir
     from vc_gym.experiments.studies.sensors import DISTANCES_M, LIGHTS, SENSORS
@@ -111,6 +115,7 @@ def test_sensors_compares_every_sensor_on_the_same_views(paper_quick):
     assert "magnetometer" in (paper_quick / "report.md").read_text()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sensor", ["feature", "magnetic"])
 def test_homing_with_a_baseline_as_the_heading_sensor(homing_quick, tmp_path, sensor):
     out = tmp_path / sensor
@@ -132,6 +137,7 @@ def test_homing_with_a_baseline_as_the_heading_sensor(homing_quick, tmp_path, se
     assert job["kwargs"]["tracker"]["sensor_file"] == str(saved.resolve())
 
 
+@pytest.mark.slow
 def test_the_scripted_agent_can_go_to_a_corrected_goal(homing_quick, tmp_path, capsys):
     out = tmp_path / "goal"
     argv = [
@@ -161,6 +167,7 @@ def test_the_scripted_agent_can_go_to_a_corrected_goal(homing_quick, tmp_path, c
     assert not (tmp_path / "bad").exists()
 
 
+@pytest.mark.slow
 def test_homing_results_and_video(homing_quick):
     r = json.loads((homing_quick / "results.json").read_text())
     assert [e["seed"] for e in r["per_episode"]] == [1, 2]
@@ -175,6 +182,7 @@ def test_homing_results_and_video(homing_quick):
     cap.release()
 
 
+@pytest.mark.slow
 def test_one_worker_and_a_resumed_run_give_the_same_bytes(homing_quick, tmp_path):
     one = tmp_path / "one"
     argv = ["experiment", "homing", "--out", str(one), *QUICK, "--workers", "1"]
@@ -190,6 +198,7 @@ def test_one_worker_and_a_resumed_run_give_the_same_bytes(homing_quick, tmp_path
     assert (one / "results.json").read_bytes() == (homing_quick / "results.json").read_bytes()
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="needs vc_gym[cluster]")
 def test_ray_gives_the_same_bytes_as_the_local_pool(homing_quick, tmp_path):
     out = tmp_path / "ray"
@@ -213,6 +222,7 @@ class DyingTracker:
         os._exit(9)
 
 
+@pytest.mark.slow
 def test_a_dead_worker_fails_its_jobs_clearly_not_the_run(homing_quick, tmp_path, capsys):
     argv = ["evaluate", "--out", str(tmp_path), "--episodes", "2", "--workers", "2"]
     argv += ["--learn-time", "0.3", "--max-homing", "15"]
@@ -299,6 +309,7 @@ def test_demo_rejects_bad_values_before_making_its_folder(tmp_path, capsys):
     assert "--learn-time" in capsys.readouterr().err and not (tmp_path / "new").exists()
 
 
+@pytest.mark.slow
 def test_bench_backends_measures_every_backend_on_the_same_jobs():
     from vc_gym.experiments.benchmarks.backends import bench_backends
 
@@ -310,6 +321,7 @@ def test_bench_backends_measures_every_backend_on_the_same_jobs():
     assert r["identical_results"]
 
 
+@pytest.mark.slow
 def test_orientation_in_both_modes(tmp_path, capsys):
     out = tmp_path / "orient"
     argv = ["experiment", "orientation", "--out", str(out), *QUICK, "--tracker", "grid"]

@@ -53,6 +53,7 @@ def _filtered(record):
     ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("env_id", ENV_IDS)
 @pytest.mark.parametrize("scene", SCENES)
 def test_gymnasium_check_env(env_id, scene):
@@ -79,6 +80,7 @@ def test_sb3_check_env(env_id):
     assert not _filtered(record), _filtered(record)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_same_seed_same_observations(env_id):
     runs = []

@@ -139,6 +139,7 @@ def test_a_rollout_is_the_same_as_the_parent_choosing_every_action():
     assert truncations > 0  # the bootstrap was exercised
 
 
+@pytest.mark.slow
 def test_the_policy_does_not_depend_on_which_worker_is_slower():
     results = []
     for delays in ([0.0, 0.006], [0.006, 0.0]):
@@ -215,6 +216,7 @@ def test_a_model_loads_only_into_a_subclass_of_its_algorithm(tmp_path):
         load_sb3_model("ppo", tmp_path / "model.zip", cls=SAC)
 
 
+@pytest.mark.slow
 def test_vc_gym_train_with_the_lockstep_collector(tmp_path):
     # TINY trains asynchronously (the default, test_training); this is SB3's collector
     config = replace(TINY, eval_freq=0, save_freq=0, collector="lockstep")

@@ -72,6 +72,7 @@ def make(place):
         env.close()
 
 
+@pytest.mark.slow
 def test_the_offset_is_the_trackers_error_at_the_stops(make):
     measured = measure_home_offset(make(BiasedOracle()), MIN_STOPS, seed=3, expert=StopAtOnce())
     np.testing.assert_allclose(measured.offset_m, BIAS, atol=1e-6)
@@ -103,6 +104,7 @@ def test_with_the_measured_offset_the_goal_is_the_true_home(make):
     assert np.hypot(*home) == pytest.approx(np.hypot(*BIAS), abs=0.02)
 
 
+@pytest.mark.slow
 def test_the_centred_goal_puts_the_experts_stops_at_the_true_home(make):
     """With an estimate that moves half as far as the robot, the goal read at the stops
     is twice the error at home and the stops overshoot; the second round going to it

@@ -27,6 +27,7 @@ def trained(tmp_path_factory):
     return out, summary
 
 
+@pytest.mark.slow
 def test_train_writes_model_config_and_log(trained):
     out, summary = trained
     assert (out / "model.zip").is_file()
@@ -42,6 +43,7 @@ def test_train_writes_model_config_and_log(trained):
     assert summary["task_steps_per_s"] >= summary["decisions_per_s"]
 
 
+@pytest.mark.slow
 def test_train_writes_what_an_sb3_user_expects(trained):
     out, summary = trained
     # SB3's per-worker monitor logs: a JSON header line, a CSV header, one row per episode
@@ -63,6 +65,7 @@ def test_train_writes_what_an_sb3_user_expects(trained):
     assert any(p.name.startswith("events.out.tfevents") for p in (out / "tb").rglob("*"))
 
 
+@pytest.mark.slow
 def test_resume_continues_from_the_latest_checkpoint(trained, tmp_path, capsys):
     import shutil
 
@@ -86,6 +89,7 @@ def test_resume_continues_from_the_latest_checkpoint(trained, tmp_path, capsys):
     assert "only --timesteps" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_speed_benchmark_reports_training_next_to_the_env():
     from vc_gym.experiments.benchmarks.train import bench_train
 
@@ -121,6 +125,7 @@ def test_the_speed_benchmark_reports_training_next_to_the_env():
         bench_train(timesteps=32, collectors=("fast",), progress=False)
 
 
+@pytest.mark.slow
 def test_reloaded_model_gives_the_same_actions(trained):
     out, _ = trained
     agent = LearnedHomingAgent(out / "model.zip")
@@ -136,6 +141,7 @@ def test_reloaded_model_gives_the_same_actions(trained):
     env.close()
 
 
+@pytest.mark.slow
 def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
     out, _ = trained
     r = run_homing(
@@ -175,6 +181,7 @@ def test_evaluate_a_learned_agent_end_to_end(trained, tmp_path, capsys):
     assert result["overall"]["episodes"] == 1 and "per_episode" not in result
 
 
+@pytest.mark.slow
 def test_warm_start_clones_the_expert_and_is_evaluated_before_ppo(tmp_path):
     config = replace(TINY, demo_episodes=2, save_freq=0, vec_env="dummy", collector="lockstep")
     summary = train(config, tmp_path, progress=False)
@@ -186,6 +193,7 @@ def test_warm_start_clones_the_expert_and_is_evaluated_before_ppo(tmp_path):
         assert list(ev["timesteps"]) == [0, 32, 64]  # the clone, then PPO's evaluations
 
 
+@pytest.mark.slow
 def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
     cfg = tmp_path / "tiny.json"
     cfg.write_text(json.dumps({**TINY.to_dict(), "save_freq": 0, "eval_freq": 64}))
@@ -209,6 +217,7 @@ def test_a_sweep_over_seeds_trains_each_and_summarises(tmp_path, capsys):
     assert main([*argv[:-1], "--seed", "3"]) == 2
 
 
+@pytest.mark.slow
 def test_agents_experiment_compares_on_the_same_kidnappings(trained, tmp_path, capsys):
     out, _ = trained
     model = str(out / "model.zip")
@@ -247,6 +256,7 @@ def test_a_bad_scene_or_tracker_in_a_config_file_fails_before_the_run_folder(
     assert value in capsys.readouterr().err and not out.exists()
 
 
+@pytest.mark.slow
 def test_training_over_a_pool_of_places(tmp_path):
     config = replace(
         TINY,
@@ -270,6 +280,7 @@ def test_training_over_a_pool_of_places(tmp_path):
     assert agent.env_kwargs == config.env_kwargs()
 
 
+@pytest.mark.slow
 def test_the_goal_correction_is_measured_kept_and_used(tmp_path):
     config = replace(
         TINY,
@@ -311,6 +322,7 @@ def test_the_command_line_asks_for_a_centred_goal():
     assert off.home_offset_centre is False and off.previous_action is False
 
 
+@pytest.mark.slow
 def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
     config = replace(
         TINY,

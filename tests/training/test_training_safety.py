@@ -65,6 +65,7 @@ def test_a_new_run_refuses_a_folder_holding_a_run_before_writing(tmp_path, held)
     assert after == before
 
 
+@pytest.mark.slow
 def test_the_command_line_refuses_an_existing_run_and_keeps_its_config(run, tmp_path, capsys):
     out = _copy(run[0], tmp_path / "run")
     config = (out / "config.json").read_bytes()
@@ -87,6 +88,7 @@ def test_a_folder_with_only_atlases_or_other_files_may_take_a_new_run(tmp_path):
         check_new_run_dir(tmp_path)
 
 
+@pytest.mark.slow
 def test_a_sweep_refuses_a_single_runs_folder(run, tmp_path):
     from vc_gym.jobs.backends import LocalBackend
     from vc_gym.training.sweep import run_train_sweep
@@ -97,6 +99,7 @@ def test_a_sweep_refuses_a_single_runs_folder(run, tmp_path):
     assert not (out / "jobs").exists()
 
 
+@pytest.mark.slow
 def test_a_sweep_job_goes_on_from_its_own_checkpoint_and_refuses_another_run(run, tmp_path):
     from vc_gym.training.sweep import train_job
 
@@ -120,6 +123,7 @@ def test_a_sweep_job_goes_on_from_its_own_checkpoint_and_refuses_another_run(run
         continue_run(TINY_LOCAL, stray)
 
 
+@pytest.mark.slow
 def test_a_sweep_job_without_a_checkpoint_starts_over_in_its_folder(run, tmp_path):
     seed0 = tmp_path / "seed-0"
     seed0.mkdir()
@@ -193,6 +197,7 @@ def test_an_interrupted_best_model_or_evaluation_leaves_the_old_one(tmp_path, mo
     env.close()
 
 
+@pytest.mark.slow
 def test_resume_skips_a_truncated_newest_checkpoint(run, tmp_path, capsys):
     out = _copy(run[0], tmp_path / "run")
     newest = out / "checkpoints" / "model_64_steps.zip"
@@ -207,6 +212,7 @@ def test_resume_skips_a_truncated_newest_checkpoint(run, tmp_path, capsys):
     assert again["skipped_checkpoints"] == []
 
 
+@pytest.mark.slow
 def test_resume_without_a_loadable_checkpoint_says_why(run, tmp_path):
     out = _copy(run[0], tmp_path / "run")
     for p in (out / "checkpoints").iterdir():
@@ -301,6 +307,7 @@ def test_the_command_line_reads_a_json_tracker_for_train():
     check_names(TrainConfig(tracker=args.tracker))
 
 
+@pytest.mark.slow
 def test_a_run_trained_with_a_tracker_dict_reads_back(run):
     out, _ = run
     saved = read_train_config(out / "config.json")
@@ -379,6 +386,7 @@ def test_the_command_line_refuses_a_files_import_path_before_anything(
     assert build_parser().parse_args(["train"]).allow_imports is False
 
 
+@pytest.mark.slow
 def test_resume_reads_the_runs_config_through_the_same_checks(run, tmp_path, evil_module, capsys):
     path_spec, marker = evil_module
     out = _copy(run[0], tmp_path / "run")
@@ -390,6 +398,7 @@ def test_resume_reads_the_runs_config_through_the_same_checks(run, tmp_path, evi
     assert not marker.exists()
 
 
+@pytest.mark.slow
 def test_a_large_or_malformed_training_log_is_refused_on_resume(run, tmp_path, monkeypatch):
     out = _copy(run[0], tmp_path / "run")
     log = out / "train_log.json"
@@ -405,6 +414,7 @@ def test_a_large_or_malformed_training_log_is_refused_on_resume(run, tmp_path, m
 # --- 7. an interrupted run stays resumable -------------------------------------------------
 
 
+@pytest.mark.slow
 def test_an_interrupted_run_keeps_whole_checkpoints_and_resumes(tmp_path, monkeypatch):
     from vc_gym.training.callbacks import AtomicCheckpoint
 

@@ -41,6 +41,7 @@ def test_shipped_hyperparameters_are_vc_gym_train_defaults(algo):
         zoo_hyperparams("dqn")
 
 
+@pytest.mark.slow
 def test_a_tiny_zoo_training_run(tmp_path):
     pytest.importorskip("rl_zoo3")
     from stable_baselines3 import PPO

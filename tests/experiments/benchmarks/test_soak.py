@@ -10,6 +10,7 @@ from vc_gym.cli import main
 from vc_gym.experiments.benchmarks.soak import rss_bytes, soak
 
 
+@pytest.mark.slow
 def test_a_short_soak_reports_speed_and_memory(tmp_path, capsys):
     r = soak(steps=60, cycles=12, window=20, seed=1, progress=False)
     assert len(r["steps_per_s"]) == len(r["rss_mb"]) == 3
