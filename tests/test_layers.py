@@ -24,6 +24,7 @@ BASE = {
     "validation",
     "persistence",
     "config_files",
+    "deprecation",
     "errors",
     "exposure",
     "plugins",

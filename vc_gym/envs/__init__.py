@@ -9,10 +9,9 @@
 The world itself (robot, scenes, camera, ``vc_gym/AiboRoom-v0``) is :mod:`vc_gym.sim`.
 """
 
-import warnings
-from typing import Any
 
 import vc_gym.sim
+from vc_gym.deprecation import moved_names
 from vc_gym.envs.homing import HomingFeatures, PreviousAction, StopAction, make_homing_env
 from vc_gym.envs.learn_then_home import LEARNING_MODES, LearnThenHomeEnv
 from vc_gym.envs.learning import (
@@ -29,16 +28,8 @@ from vc_gym.envs.learning import (
 from vc_gym.envs.place_pool import PlacePool
 from vc_gym.envs.wrappers import CompassObservation
 
-
-def __getattr__(name: str) -> Any:
-    # every public name of vc_gym.sim lived here before it moved: still served, for one
-    # release, with a DeprecationWarning
-    if name in vc_gym.sim.__all__:
-        warnings.warn(
-            f"vc_gym.envs.{name} moved to vc_gym.sim.{name}", DeprecationWarning, stacklevel=2
-        )
-        return getattr(vc_gym.sim, name)
-    raise AttributeError(f"module 'vc_gym.envs' has no attribute {name!r}")
+# the public names of vc_gym.sim, served here for one release with a DeprecationWarning
+__getattr__ = moved_names(__name__, dict.fromkeys(vc_gym.sim.__all__, vc_gym.sim))
 
 
 __all__ = [

@@ -11,10 +11,9 @@ Import them from the module of their concept instead: :mod:`vc_gym.jobs.job` (``
 
 from __future__ import annotations
 
-import warnings
 from types import ModuleType
-from typing import Any
 
+from vc_gym.deprecation import moved_names
 from vc_gym.jobs import backends, job, output, run, workers
 
 #: Each name served here and the module that holds it.
@@ -37,13 +36,4 @@ MOVED: dict[str, ModuleType] = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = MOVED.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    warnings.warn(
-        f"vc_gym.jobs.runner.{name} moved to {module.__name__}.{name}",
-        DeprecationWarning,
-        stacklevel=2,
-    )
-    return getattr(module, name)
+__getattr__ = moved_names(__name__, MOVED)

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.deprecation import moved_names
 from vc_gym.jobs.output import check_out_dir, new_figure, save_figure, write_json
 from vc_gym.persistence import write_atomic
 from vc_gym.training import config as config_module
@@ -78,16 +79,7 @@ MOVED: dict[str, ModuleType] = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = MOVED.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    warnings.warn(
-        f"vc_gym.training.train.{name} moved to {module.__name__}.{name}",
-        DeprecationWarning,
-        stacklevel=2,
-    )
-    return getattr(module, name)
+__getattr__ = moved_names(__name__, MOVED)
 
 
 def _check_start(config: TrainConfig, tensorboard_log: str | os.PathLike | None) -> None:

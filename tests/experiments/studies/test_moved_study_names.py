@@ -7,7 +7,7 @@ import importlib
 
 import pytest
 
-from vc_gym.experiments.studies.common import moved_names
+from vc_gym.deprecation import moved_names
 
 S = "vc_gym.experiments.studies."
 MOVED = [

@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import json
 import os
-import warnings
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -23,7 +21,6 @@ __all__ = [
     "check_scenes",
     "check_tracker_spec",
     "median_timings",
-    "moved_names",
     "one_scene",
     "open_run",
     "pick_size",
@@ -143,25 +140,3 @@ def check_tracker_spec(tracker: Any) -> Any:
         )
     make_tracker(tracker)  # an unknown tracker fails here, not in a worker
     return json.loads(json.dumps(tracker))
-
-
-def moved_names(module: str, moves: Mapping[str, tuple[ModuleType, str]]) -> Callable[[str], Any]:
-    """A module ``__getattr__`` (PEP 562) serving public names that moved elsewhere.
-
-    ``moves`` maps each old name to ``(new module, new name)``. For one release the old
-    name still gives the very same object, with a ``DeprecationWarning`` that names its
-    new place; any other missing name is an ``AttributeError`` as usual.
-    """
-
-    def __getattr__(name: str) -> Any:
-        if name not in moves:
-            raise AttributeError(f"module {module!r} has no attribute {name!r}")
-        new_module, new_name = moves[name]
-        warnings.warn(
-            f"{module}.{name} moved to {new_module.__name__}.{new_name}",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return getattr(new_module, new_name)
-
-    return __getattr__

@@ -22,6 +22,7 @@ import numpy as np
 
 from vc_gym.agents.learned import PRETRAINED_MODEL, LearnedHomingAgent
 from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.deprecation import moved_names
 from vc_gym.envs.homing import home_offset
 from vc_gym.envs.learning import HOME
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
@@ -36,14 +37,13 @@ from vc_gym.experiments.studies import kidnapping
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     check_tracker_spec,
-    moved_names,
     open_run,
     pick_size,
     scene_field_bounds,
 )
 from vc_gym.experiments.studies.kidnapping import EPISODE_JOB
 from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
-from vc_gym.heading_sensors import IMAGE_SENSORS, SENSOR_GRID
+from vc_gym.heading_sensors import IMAGE_SENSORS, SENSOR_GRID, current_sensor_name
 from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
 from vc_gym.jobs.workers import worker_cache
@@ -214,6 +214,7 @@ def run_homing(
     mode = canonical_homing_mode(mode)
     tracker = check_tracker_spec(tracker)
     if sensor is not None:
+        sensor = current_sensor_name(sensor)  # a deprecated name warns and is replaced
         grid_options = _sensor_tracker_options(sensor, tracker, relearn)
     if home_offset_m is not None:
         if agent != "scripted":

@@ -54,9 +54,9 @@ import numpy as np
 
 import vc_gym.localization
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
+from vc_gym.deprecation import moved_names
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
-    moved_names,
     one_scene,
     open_run,
     pick_size,

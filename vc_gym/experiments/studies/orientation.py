@@ -27,11 +27,11 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.deprecation import moved_names
 from vc_gym.experiments.studies import common, orientation_grid
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
     median_timings,
-    moved_names,
     open_run,
     pick_size,
 )

@@ -17,9 +17,7 @@ same object.
 
 from __future__ import annotations
 
-import warnings
-from typing import Any
-
+from vc_gym.deprecation import moved_names
 from vc_gym.sim.scenes import builder, choices, parts, rooms, scene
 
 _MOVED = {
@@ -40,18 +38,4 @@ _MOVED = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = _MOVED.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    warnings.warn(
-        f"vc_gym.sim.scenes.base is deprecated; import {name} from vc_gym.sim.scenes "
-        f"(or {module.__name__})",
-        DeprecationWarning,
-        stacklevel=2,
-    )
-    return getattr(module, name)
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_MOVED))
+__getattr__ = moved_names(__name__, _MOVED)
