@@ -15,13 +15,15 @@ NAMES = [
 
 @pytest.mark.parametrize("name", NAMES)
 def test_each_old_name_warns_and_returns_the_same_object(name):
-    with pytest.warns(DeprecationWarning, match=f"vc_gym.sim.scenes.base.{name} moved to vc_gym.sim.scenes."):
+    moved = f"vc_gym.sim.scenes.base.{name} moved to vc_gym.sim.scenes."
+    with pytest.warns(DeprecationWarning, match=moved):
         old = getattr(base, name)
     assert old is getattr(scenes, name)
 
 
 def test_from_import_warns_too():
-    with pytest.warns(DeprecationWarning, match="vc_gym.sim.scenes.base.Room moved to vc_gym.sim.scenes.rooms.Room"):
+    moved = "vc_gym.sim.scenes.base.Room moved to vc_gym.sim.scenes.rooms.Room"
+    with pytest.warns(DeprecationWarning, match=moved):
         from vc_gym.sim.scenes.base import Room
     assert Room is scenes.Room
 
