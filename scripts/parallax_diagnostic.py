@@ -46,7 +46,7 @@ from vc_gym.compass.parallax import ParallaxMap, learn_depths
 from vc_gym.experiments.atlases import atlas_spec, learn_atlas_job
 from vc_gym.experiments.studies.common import scene_field_bounds
 from vc_gym.experiments.studies.orientation_grid import GRID_AROUND_M, training_spots
-from vc_gym.experiments.views import field_grid, learning_turn, look, view_poses
+from vc_gym.experiments.views import field_grid, frames_at_pose, learning_turn, view_poses
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.worlds.room import make_room, render_room_view
 
@@ -136,7 +136,7 @@ def main() -> None:
     )
     grid = field_grid(tuple(env.scene.field_bounds), 0.5)
     poses = view_poses(grid, 2, np.random.default_rng([args.seed, 51]))
-    views = [look(env, tuple(p), 10, seed=1000 + k) for k, p in enumerate(poses)]
+    views = [frames_at_pose(env, tuple(p), 10, seed=1000 + k) for k, p in enumerate(poses)]
     headings = np.arange(360.0)
     if args.joint:
         if args.ray_depths:

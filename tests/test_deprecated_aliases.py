@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+import warnings
 
 import pytest
 
@@ -15,6 +16,18 @@ def test_baselines_is_heading_sensors_with_a_warning():
     import vc_gym.heading_sensors as new
 
     assert old.make_sensor is new.make_sensor and old.__all__ == new.__all__
+
+
+@pytest.mark.parametrize("package", ["vc_gym.heading_sensors", "vc_gym.baselines"])
+def test_sector_colour_compass_is_sector_color_compass_with_a_warning(package):
+    from vc_gym.heading_sensors import SectorColorCompass
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # vc_gym.baselines itself
+        module = importlib.import_module(package)
+    with pytest.warns(DeprecationWarning, match="SectorColorCompass"):
+        assert module.SectorColourCompass is SectorColorCompass
+    assert "SectorColourCompass" not in module.__all__
 
 
 @pytest.mark.parametrize("name", ["AiboRoomEnv", "Quadruped", "build_scene", "SCENES"])

@@ -61,8 +61,15 @@ def test_a_good_file_round_trips(good):
     np.testing.assert_array_equal(load_npz_checked(good, SCHEMA, VERSION)["a"], np.arange(6.0))
 
 
+def test_another_spelling_of_the_schema_reads_as_the_schema(good):
+    arrays = load_npz_checked(good, "vc_gym.Other", VERSION, legacy_schemas=(SCHEMA,))
+    np.testing.assert_array_equal(arrays["a"], np.arange(6.0))
+    with pytest.raises(MapFileError, match="expected a 'vc_gym.Other'"):
+        load_npz_checked(good, "vc_gym.Other", VERSION, legacy_schemas=("vc_gym.Else",))
+
+
 def test_a_huge_zero_entry_is_refused_before_it_is_decompressed(tmp_path):
-    # 1 GiB of zeros compresses to ~1 MB; it used to be decompressed (1.6 GB peak)
+    # 1 GiB of zeros compresses to ~1 MB; decompressing it would peak at 1.6 GB
     path = tmp_path / "bomb.npz"
     header = _header_only((2**27,))
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
@@ -78,7 +85,7 @@ def test_a_huge_zero_entry_is_refused_before_it_is_decompressed(tmp_path):
 
 
 def test_a_header_declaring_a_huge_shape_is_refused(tmp_path):
-    # used to raise MemoryError
+    # a MapFileError, not a MemoryError
     bad = _zip(tmp_path / "shape.npz", {**_base(), "a.npy": _header_only((10**6, 10**6))})
     with pytest.raises(MapFileError, match="shape.npz.*declares shape"):
         load_npz_checked(bad, SCHEMA, VERSION)
@@ -118,7 +125,7 @@ def test_a_schema_version_that_is_not_an_integer_is_refused(tmp_path, version):
 
 
 def test_bit_flips_and_a_renamed_npy_give_map_file_errors(good, tmp_path):
-    # a flipped bit used to escape as zlib.error, a renamed .npy as TypeError
+    # no flipped bit escapes as zlib.error, no renamed .npy as TypeError
     data = good.read_bytes()
     errors = 0
     for i in range(0, len(data), max(1, len(data) // 80)):
@@ -166,7 +173,7 @@ def test_compass_entries_of_the_wrong_kind(room_compass, tmp_path, key, value, m
 
 
 def test_a_deeply_nested_config_is_a_map_file_error(room_compass, tmp_path):
-    # used to escape as RecursionError
+    # a MapFileError, not a RecursionError
     arrays = dict(room_compass.to_arrays())
     arrays["config"] = np.array("[" * 100_000 + "]" * 100_000)
     entries = {f"{k}.npy": _npy(np.asarray(v)) for k, v in arrays.items()}
@@ -179,7 +186,7 @@ def test_a_deeply_nested_config_is_a_map_file_error(room_compass, tmp_path):
 
 @pytest.mark.parametrize(("umask", "expected"), [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
 def test_saved_files_get_the_permissions_of_the_umask(tmp_path, umask, expected):
-    """A map used to be written 0600 whatever the umask (the temporary file's mode)."""
+    """A map gets the permissions of the umask, not the temporary file's 0600."""
     import os
     import stat
 

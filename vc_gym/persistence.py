@@ -178,6 +178,7 @@ def load_npz_checked(
     max_entry_bytes: int = MAX_ENTRY_BYTES,
     max_total_bytes: int = MAX_TOTAL_BYTES,
     max_members: int = MAX_MEMBERS,
+    legacy_schemas: Sequence[str] = (),
 ) -> dict[str, np.ndarray]:
     """Load every array of an ``.npz`` written by :func:`save_npz_atomic`, safely.
 
@@ -188,7 +189,8 @@ def load_npz_checked(
     ``max_entry_bytes`` (all entries together within ``max_total_bytes``), of a plain
     kind (bool, integer, real, text: never objects, so nothing is unpickled) and
     named once. A hostile file therefore cannot run code, exhaust memory or take long
-    to refuse.
+    to refuse. A file whose schema is one of ``legacy_schemas`` (another spelling of
+    ``schema``) is read as a ``schema`` file.
 
     Raises
     ------
@@ -214,7 +216,7 @@ def load_npz_checked(
     got = arrays.pop("schema")
     if got.dtype.kind != "U" or got.ndim != 0:
         raise MapFileError(f"{path}: schema is not a text entry")
-    if str(got) != schema:
+    if str(got) != schema and str(got) not in legacy_schemas:
         raise MapFileError(f"{path}: holds a {str(got)!r}, expected a {schema!r}")
     got_version = arrays.pop("schema_version")
     if got_version.dtype.kind not in "iu" or got_version.ndim != 0:

@@ -152,7 +152,7 @@ def test_bad_spot_subsets_are_refused(atlas, room, spots):
 
 
 def test_a_narrow_normalisation_kernel_keeps_the_position_finite(atlas, room):
-    # kernel_deg=0.01 used to underflow every home weight to 0: position (nan, nan)
+    # kernel_deg=0.01 underflows every raw home weight to 0 (0 / 0: position (nan, nan))
     spots = zip(atlas.names, atlas.positions, atlas.compasses, strict=True)
     fresh = CompassAtlas(
         {n: (tuple(p), vc) for n, p, vc in spots},

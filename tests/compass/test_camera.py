@@ -46,9 +46,9 @@ def test_principal_point_crop():
         {"pitch_deg": 90.0},
         {"principal_point": (1.0,)},
         {"principal_point": (1.0, float("nan"))},
-        {"hfov_deg": True},  # used to become a 1-degree lens
-        {"hfov_deg": "56.9"},  # used to be accepted and fail later
-        {"yaw_deg": 1e17},  # used to learn 4 of 14 sectors
+        {"hfov_deg": True},  # a bool, not a 1-degree lens
+        {"hfov_deg": "56.9"},  # refused here, not failing later
+        {"yaw_deg": 1e17},  # beyond float precision: would learn 4 of 14 sectors
         {"yaw_deg": -1e300},
         {"pitch_deg": False},
     ],

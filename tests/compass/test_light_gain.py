@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from vc_gym.compass.light_gain import (
-    colour_fitting_levels,
+    color_fitting_levels,
     exposure_corrected,
     frame_gain_of,
     profile_log_likelihood,
@@ -24,7 +24,7 @@ def test_the_reference_is_read_from_the_upper_halves():
     image[:2] = 200  # the upper half (2 of 5 rows) is bright, the rest black
     assert upper_half(image).shape == (2, 4, 3)
     assert upper_half(image[:1]).shape == (1, 4, 3)  # at least one row
-    assert colour_fitting_levels([image]) == [mean_linear_level(image[:2])]
+    assert color_fitting_levels([image]) == [mean_linear_level(image[:2])]
 
 
 def test_a_frame_is_scaled_to_the_reference_level():
@@ -74,3 +74,10 @@ def test_each_heading_takes_the_log_likelihood_at_its_own_gain():
         ll, [1.0, 2.0, 3 * step_gain(3), 4 * step_gain(3), 5 * step_gain(-3)]
     )
     assert best == 3 and best_features[0][0] == step_gain(3)
+
+
+def test_colour_fitting_levels_is_a_deprecated_alias():
+    from vc_gym.compass import light_gain
+
+    with pytest.warns(DeprecationWarning, match="color_fitting_levels"):
+        assert light_gain.colour_fitting_levels is color_fitting_levels

@@ -122,7 +122,7 @@ def test_compasses_sharing_exposure_normalised_colours_learn_and_localise(
     tmp_path, room_pano, make_learned_compass
 ):
     # the learners fit colours once and give them to every spot's compass; the
-    # exposure reference must travel with the classes (it used to be lost: gain 0)
+    # exposure reference must travel with the classes (without it the gain is 0)
     first = make_learned_compass(room_pano, CompassConfig(exposure="mean", n_colors=4))
     assert first.colors.exposure_reference > 0
     second = VisualCompass(first.config, first.colors)
@@ -196,6 +196,7 @@ def test_nothing_above_horizon(room_pano, room_compass):
         np.zeros((160, 208, 3), dtype=np.float32),
         np.zeros((160, 208), dtype=np.uint8),
         np.zeros((160, 208, 4), dtype=np.uint8),
+        np.zeros((3, 160, 208), dtype=np.uint8),  # channels first
         np.zeros((0, 208, 3), dtype=np.uint8),
         [[1, 2, 3]],
     ],
@@ -241,7 +242,7 @@ def test_config_validation():
         {"n_bins": 1},
         {"coverage": 0.0},
         {"coverage": float("nan")},
-        {"coverage": 1e-9},  # used to learn nothing
+        {"coverage": 1e-9},  # would learn nothing
         {"coverage": 0.0009},
         {"heading_step_deg": 0.7},
         {"heading_step_deg": 1e-9},  # divides 360, but 3.6e11 headings
@@ -383,7 +384,8 @@ def test_merge_refuses_other_configs_or_colours(room_pano, room_compass):
 
 @pytest.mark.parametrize("colour", [(0, 0, 0), (255, 255, 255), (90, 140, 200)])
 def test_a_frame_without_colour_changes_gives_a_flat_likelihood(room_pano, room_compass, colour):
-    # an all-black frame used to fit better (-0.097) than the true frame, with a 3.7° spread
+    # scored like any frame, all-black would fit better (-0.097) than the true frame,
+    # with a 3.7° spread
     frame = np.empty((160, 208, 3), np.uint8)
     frame[:] = colour
     ll = room_compass.log_likelihood(frame, Camera())
@@ -405,7 +407,8 @@ def _noise(kind: str, rng: np.random.Generator) -> np.ndarray:
 
 @pytest.mark.parametrize("kind", ["uniform", "grey", "blocks2"])
 def test_a_frame_of_noise_gives_a_flat_likelihood(room_pano, room_compass, kind):
-    # uniform noise used to get a confident (1.9° spread) and arbitrary heading
+    # scored like any frame, uniform noise would get a confident (1.9° spread) and
+    # arbitrary heading
     frame = _noise(kind, np.random.default_rng(3))
     assert np.all(room_compass.log_likelihood(frame, Camera()) == 0.0)
     est = room_compass.estimate(frame, Camera())

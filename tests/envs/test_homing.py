@@ -95,8 +95,8 @@ def test_stop_action_holds_still_until_the_task_stops():
 @pytest.mark.slow
 @pytest.mark.parametrize("walk", [[0.0, 0.0, 0.0], [-1.0, 0.02, -1.0], [-0.5, -0.01, 0.4]])
 def test_only_the_stop_output_ends_an_episode(walk):
-    # a walk decision too small to move used to count as standing still, so the task's
-    # short training stop time ended the episode by accident
+    # a walk decision too small to move is not standing still: if it were, the task's
+    # short training stop time would end the episode by accident
     env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=0.1, max_homing_s=3.0)
     env.reset(seed=0, options={"pose": (1.0, 0.0, 0.0)})
     for _ in range(10):

@@ -16,11 +16,9 @@ def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
     code = main(["check", "--soak-steps", "40", "--soak-cycles", "10", "--out", str(out)])
     r = json.loads(out.read_text())
     assert code == 0, r["failures"]
-    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 110
+    assert r["failed"] == 0 and r["tried"] == r["passed"] == len(all_cases()) >= 80
     assert set(r["suites"]) == {
-        "bad_input",
         "hostile_file",
-        "sensors",
         "envs",
         "fault",
         "code_in_files",

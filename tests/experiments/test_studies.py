@@ -103,7 +103,7 @@ def test_sensors_compares_every_sensor_on_the_same_views(paper_quick):
             assert at_spot["median_abs_error_deg"] <= at_spot["p90_abs_error_deg"]
         assert {k.split("m_")[0] for k in per["all_scenes"]} <= {f"{d:g}" for d in DISTANCES_M}
     # at the spot in full light every image sensor knows its heading
-    for name in ("visual_compass_mean_exposure", "image_difference", "feature", "sector_colour"):
+    for name in ("visual_compass_mean_exposure", "image_difference", "feature", "sector_color"):
         assert sim[name]["all_scenes"]["0m_light1"]["median_abs_error_deg"] < 5.0, name
     if default_real_data_dir() is not None:
         assert set(r["real"]) == {"rotation_grail", "rotation_parrington"}
@@ -284,7 +284,7 @@ def test_a_flag_the_experiment_does_not_declare_is_refused_with_its_own_usage(
     "argv",
     [
         ["experiment", "homing", "--quick"],
-        ["demo", "--learn-time", "0.2"],  # used to be a FileExistsError traceback
+        ["demo", "--learn-time", "0.2"],  # a file in the way is a clear error, not a traceback
         ["render"],  # the same
         ["evaluate", "--episodes", "1"],
         ["train", "--timesteps", "64"],
@@ -298,7 +298,7 @@ def test_an_output_that_is_a_file_is_refused_at_once(tmp_path, capsys, argv):
 
 
 def test_bench_refuses_a_folder_as_its_output_file_before_measuring(tmp_path, capsys):
-    # it used to measure, then fail with IsADirectoryError and leave a stray temp file
+    # refused before measuring: no IsADirectoryError after the run, no stray temp file
     assert main(["bench", "compass", "--out", str(tmp_path)]) == 2
     assert "is a folder" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []

@@ -19,7 +19,7 @@ HOMES = {
     "evaluate_view": "evaluation",
     "field_grid": "poses",
     "learning_turn": "frames",
-    "look": "frames",
+    "frames_at_pose": "frames",
     "plot_arrow_field": "arrow_field",
     "plot_error_vs_distance": "error_vs_distance",
     "plot_goodness_field": "goodness_field",

@@ -230,9 +230,9 @@ def test_heading_always_in_range_and_spread_shrinks_on_update(h0, steps):
         lambda f: f.update(10.0, 0.0),
         lambda f: f.update(10.0, -1.0),
         lambda f: f.update(10.0, 1e-200),
-        lambda f: f.update(20.0, 1e-160),  # used to leave the filter failing on every call
+        lambda f: f.update(20.0, 1e-160),  # must not leave the filter failing on every call
         lambda f: f.update(1e300, 1.0),
-        lambda f: f.predict(10.0, noise_deg=1e155),  # used to leave the filter failing too
+        lambda f: f.predict(10.0, noise_deg=1e155),  # nor must this one
         lambda f: f.predict(1e300),
         lambda f: f.predict(math.nan),
         lambda f: f.predict(1.0, noise_deg=-0.1),
@@ -259,6 +259,19 @@ def test_bad_input_raises_value_error_and_keeps_state(call):
     f.predict(5.0)  # and the filter still works
     f.update(47.0, 2.0)
     assert abs(wrap180(f.estimate().heading_deg - 47.0)) < 2.0
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda f: f.update(20.0, 1e-160), "spread_deg must be >="),
+        (lambda f: f.predict(10.0, noise_deg=1e155), "noise_deg must be within"),
+    ],
+)
+def test_a_vanishing_spread_or_a_huge_noise_names_its_limit(call, message):
+    f = KalmanHeadingFilter(10.0, 5.0)
+    with pytest.raises(ValueError, match=message):
+        call(f)
 
 
 @pytest.mark.parametrize(

@@ -468,7 +468,7 @@ def test_resampling_injects_poses_from_a_given_sampler():
     [((1e308, 0.0, 0.0), (0.0, 0.0, 0.0)), ((0.0, 0.0, 0.0), (0.0, 0.0, 1e300))],
 )
 def test_motion_beyond_physical_limits_is_refused(odometry, noise):
-    # odometry of 1e308 m used to give a NaN estimate silently
+    # odometry of 1e308 m is refused, not turned silently into a NaN estimate
     pf = ParticleFilter(100, rng=np.random.default_rng(0))
     pf.reset(mean=(0.0, 0.0, 0.0), std=(0.1, 0.1, 5.0))
     with pytest.raises(ValueError, match="within"):

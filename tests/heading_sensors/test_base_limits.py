@@ -9,12 +9,12 @@ import pytest
 
 from vc_gym.compass import Camera
 from vc_gym.errors import MapFileError
-from vc_gym.heading_sensors.sector_color import SectorColourCompass
+from vc_gym.heading_sensors.sector_color import SectorColorCompass
 from vc_gym.worlds.panorama import render_view
 
 
 def test_a_config_too_large_to_allocate_is_a_map_file_error(room_pano, tmp_path):
-    sc = SectorColourCompass(model="histogram")
+    sc = SectorColorCompass(model="histogram")
     sc.learn(render_view(room_pano, Camera(yaw_deg=10.0)), Camera(yaw_deg=10.0))
     path = sc.save(tmp_path / "sensor.npz")
     with np.load(path, allow_pickle=False) as d:
@@ -24,4 +24,4 @@ def test_a_config_too_large_to_allocate_is_a_map_file_error(room_pano, tmp_path)
     arrays["config"] = np.array(json.dumps(config))
     np.savez(tmp_path / "huge.npz", **arrays)
     with pytest.raises(MapFileError, match="huge.npz: bad config.*n_bins"):
-        SectorColourCompass.load(tmp_path / "huge.npz")
+        SectorColorCompass.load(tmp_path / "huge.npz")

@@ -266,6 +266,7 @@ def test_bad_camera_is_rejected(room_pano, room_fc):
         ({"max_keypoints": 0}, "max_keypoints"),
         ({"seed": -1}, "seed"),
         ({"heading_step_deg": 7.0}, "heading_step_deg"),
+        ({"heading_step_deg": float("nan")}, "heading_step_deg"),
     ],
 )
 def test_bad_parameters_are_rejected(kwargs, name):

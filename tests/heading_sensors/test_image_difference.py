@@ -334,8 +334,9 @@ def test_corrupt_file(tmp_path, saved):
 def test_inconsistent_file(saved, change, message):
     path, arrays = saved
     change(arrays)
-    with pytest.raises(MapFileError, match=message):
+    with pytest.raises(MapFileError, match=message) as info:
         ImageDifferenceCompass.load(_rewrite(path, arrays))
+    assert path.name in str(info.value)
 
 
 def test_bad_config_and_other_schema(saved):

@@ -12,15 +12,15 @@ from vc_gym.compass import Camera
 from vc_gym.errors import MapFileError, NotLearnedError
 from vc_gym.experiments.real_data import load_rotation_set
 from vc_gym.experiments.real_rotation import rotation_set_errors
-from vc_gym.heading_sensors.sector_color import SectorColourCompass
+from vc_gym.heading_sensors.sector_color import SectorColorCompass
 from vc_gym.worlds.panorama import render_view
 
 #: Learning yaws of tests/conftest.py: 8 body directions x 3 head pans (paper 4.3).
 LEARN_YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]
 
 
-def learned(pano, yaws=LEARN_YAWS, **kwargs) -> SectorColourCompass:
-    sc = SectorColourCompass(**kwargs)
+def learned(pano, yaws=LEARN_YAWS, **kwargs) -> SectorColorCompass:
+    sc = SectorColorCompass(**kwargs)
     for yaw in yaws:
         sc.learn(render_view(pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
     return sc
@@ -206,7 +206,7 @@ def test_a_frame_that_sees_no_sector(room_pano, room_map):
     np.testing.assert_array_equal(s.log_likelihood, np.zeros(360))
     assert s.goodness == -math.inf and s.n_terms == 0
     with pytest.raises(ValueError, match="no sector"):
-        SectorColourCompass().learn(img, cam)
+        SectorColorCompass().learn(img, cam)
 
 
 # ---------------------------------------------------------------- real photos
@@ -221,7 +221,7 @@ def real_sets(real_data_dir):
 def real_crop_errors(photos, **kwargs) -> np.ndarray:
     """evaluate_rotation_set's protocol: learn the even photos, 3 half-width crops
     of each odd photo."""
-    return np.array(rotation_set_errors(photos, SectorColourCompass(**kwargs))["errors_deg"])
+    return np.array(rotation_set_errors(photos, SectorColorCompass(**kwargs))["errors_deg"])
 
 
 @pytest.mark.parametrize("model", ["gaussian", "histogram"])
@@ -242,7 +242,7 @@ def test_real_rotation_crops(real_sets, name, median_bound, within10, model):
 def test_real_whole_photos(real_sets):
     # whole odd photos (7-8 sectors each) are found far better than half crops
     for photos in real_sets.values():
-        sc = SectorColourCompass()
+        sc = SectorColorCompass()
         for p in photos[0::2]:
             sc.learn(p.image, Camera.from_focal(p.focal_px, p.image.shape[1], yaw_deg=p.yaw_deg))
         errs = [
@@ -271,7 +271,7 @@ def test_bad_images_are_rejected(room_map, bad):
     with pytest.raises(ValueError):
         room_map.log_likelihood(bad, Camera())
     with pytest.raises(ValueError):
-        SectorColourCompass().learn(bad, Camera())
+        SectorColorCompass().learn(bad, Camera())
 
 
 def test_bad_camera_is_rejected(room_map, room_pano):
@@ -280,7 +280,7 @@ def test_bad_camera_is_rejected(room_map, room_pano):
         with pytest.raises(ValueError, match="Camera"):
             room_map.estimate(img, cam)
         with pytest.raises(ValueError, match="Camera"):
-            SectorColourCompass().learn(img, cam)
+            SectorColorCompass().learn(img, cam)
     with pytest.raises(ValueError, match="image, camera"):
         room_map.heading_log_likelihood(img, np.zeros(3))
 
@@ -297,6 +297,7 @@ def test_bad_camera_is_rejected(room_map, room_pano):
         ({"features": "hsv"}, "features"),
         ({"heading_step_deg": 0.7}, "heading_step_deg"),
         ({"heading_step_deg": float("inf")}, "heading_step_deg"),
+        ({"heading_step_deg": float("nan")}, "heading_step_deg"),
         ({"az_step_deg": 0.7}, "az_step_deg"),
         ({"el_min_deg": 20.0, "el_max_deg": 10.0}, "el_m"),
         ({"el_step_deg": 0.0}, "el_step_deg"),
@@ -315,11 +316,11 @@ def test_bad_camera_is_rejected(room_map, room_pano):
 )
 def test_bad_parameters_are_rejected(kwargs, message):
     with pytest.raises(ValueError, match=message):
-        SectorColourCompass(**kwargs)
+        SectorColorCompass(**kwargs)
 
 
 def test_not_learned_errors(room_pano, tmp_path):
-    sc = SectorColourCompass()
+    sc = SectorColorCompass()
     img = render_view(room_pano, Camera())
     assert not sc.is_learned and sc.learned_fraction == 0.0
     with pytest.raises(NotLearnedError):
@@ -333,7 +334,7 @@ def test_not_learned_errors(room_pano, tmp_path):
 # ---------------------------------------------------------------- persistence
 @pytest.fixture(scope="module")
 def saved(maps, tmp_path_factory):
-    folder = tmp_path_factory.mktemp("sector_colour")
+    folder = tmp_path_factory.mktemp("sector_color")
     return {
         model: maps["room", model].save(folder / f"{model}.npz")
         for model in ("gaussian", "histogram")
@@ -342,7 +343,7 @@ def saved(maps, tmp_path_factory):
 
 @pytest.mark.parametrize("model", ["gaussian", "histogram"])
 def test_save_load_round_trip(maps, saved, room_pano, model):
-    loaded = SectorColourCompass.load(saved[model])
+    loaded = SectorColorCompass.load(saved[model])
     original = maps["room", model]
     assert loaded.model == model and loaded.frames_learned == original.frames_learned
     assert repr(loaded) == repr(original)
@@ -352,6 +353,31 @@ def test_save_load_round_trip(maps, saved, room_pano, model):
             loaded.log_likelihood(img, Camera()), original.log_likelihood(img, Camera())
         )
         assert loaded.estimate(img, Camera()).score == original.estimate(img, Camera()).score
+
+
+def test_a_file_with_the_british_schema_name_loads(maps, saved, room_pano, tmp_path):
+    from vc_gym.heading_sensors import load_sensor
+
+    with np.load(saved["gaussian"]) as data:
+        assert str(data["schema"]) == "vc_gym.SectorColorCompass"
+    british = _set("schema", np.array("vc_gym.SectorColourCompass"))
+    old = _rewrite(saved["gaussian"], tmp_path / "old.npz", british)
+    img = render_view(room_pano, Camera(yaw_deg=123.4))
+    expected = maps["room", "gaussian"].log_likelihood(img, Camera())
+    loaded = SectorColorCompass.load(old)
+    np.testing.assert_array_equal(loaded.log_likelihood(img, Camera()), expected)
+    loaded = load_sensor("sector_color", old)
+    np.testing.assert_array_equal(loaded.log_likelihood(img, Camera()), expected)
+    with pytest.warns(DeprecationWarning, match="'sector_color'"):
+        loaded = load_sensor("sector_colour", old)
+    assert isinstance(loaded, SectorColorCompass)
+
+
+def test_sector_colour_compass_is_a_deprecated_alias():
+    from vc_gym.heading_sensors import sector_color
+
+    with pytest.warns(DeprecationWarning, match="SectorColorCompass"):
+        assert sector_color.SectorColourCompass is SectorColorCompass
 
 
 def _rewrite(src, dst, change):
@@ -389,7 +415,7 @@ def _set(key, value):
 def test_bad_files_give_map_file_errors(saved, tmp_path, model, change, message):
     bad = _rewrite(saved[model], tmp_path / "bad.npz", change)
     with pytest.raises(MapFileError, match=message) as info:
-        SectorColourCompass.load(bad)
+        SectorColorCompass.load(bad)
     assert "bad.npz" in str(info.value)
 
 
@@ -397,6 +423,6 @@ def test_truncated_and_missing_files(saved, tmp_path):
     cut = tmp_path / "cut.npz"
     cut.write_bytes(saved["gaussian"].read_bytes()[:300])
     with pytest.raises(MapFileError, match="cut.npz"):
-        SectorColourCompass.load(cut)
+        SectorColorCompass.load(cut)
     with pytest.raises(MapFileError, match="no such file"):
-        SectorColourCompass.load(tmp_path / "absent.npz")
+        SectorColorCompass.load(tmp_path / "absent.npz")

@@ -14,7 +14,7 @@ from vc_gym.heading_sensors import (
     FeatureCompass,
     ImageDifferenceCompass,
     NoisyMagneticCompass,
-    SectorColourCompass,
+    SectorColorCompass,
     make_sensor,
     register_sensor,
 )
@@ -27,7 +27,7 @@ from vc_gym.worlds.panorama import render_view
     [
         ("visual_compass", VisualCompass),
         ("image_difference", ImageDifferenceCompass),
-        ("sector_colour", SectorColourCompass),
+        ("sector_color", SectorColorCompass),
         ("feature", FeatureCompass),
         ("magnetic", NoisyMagneticCompass),
         ({"type": "magnetic", "noise_deg": 7.0}, NoisyMagneticCompass),
@@ -37,6 +37,34 @@ from vc_gym.worlds.panorama import render_view
 )
 def test_specs(spec, cls):
     assert type(make_sensor(spec)) is cls
+
+
+@pytest.mark.parametrize("spec", ["sector_colour", {"type": "sector_colour", "model": "histogram"}])
+def test_the_british_sector_name_is_a_deprecated_alias(spec):
+    message = "'sector_colour' is deprecated; use 'sector_color'"
+    with pytest.warns(DeprecationWarning, match=message):
+        sensor = make_sensor(spec)
+    assert type(sensor) is SectorColorCompass
+    assert "sector_colour" not in SENSORS and SectorColorCompass.name == "sector_color"
+
+
+def test_a_saved_sector_sensor_loads_under_the_british_name(room_pano, tmp_path):
+    from vc_gym.heading_sensors import SENSOR_GRID, load_sensor
+    from vc_gym.localization import make_tracker
+
+    sensor = make_sensor("sector_color")
+    for yaw in range(0, 360, 30):
+        sensor.learn(render_view(room_pano, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
+    path = sensor.save(tmp_path / "home.npz")
+    with pytest.warns(DeprecationWarning, match="'sector_color'"):
+        loaded = load_sensor("sector_colour", path)
+    image = render_view(room_pano, Camera(yaw_deg=77.0))
+    assert np.array_equal(
+        loaded.log_likelihood(image, Camera()), sensor.log_likelihood(image, Camera())
+    )
+    spec = {"type": SENSOR_GRID, "sensor": "sector_colour", "sensor_file": str(path)}
+    with pytest.warns(DeprecationWarning, match="'sector_color'"):
+        assert isinstance(make_tracker(spec).heading_sensor, SectorColorCompass)
 
 
 def test_dict_kwargs_reach_the_constructor():
@@ -72,7 +100,7 @@ def test_register_a_users_sensor():
         del SENSORS["my_magnetometer"]
 
 
-@pytest.mark.parametrize("name", ["image_difference", "sector_colour", "feature"])
+@pytest.mark.parametrize("name", ["image_difference", "sector_color", "feature"])
 def test_every_image_baseline_is_a_filters_heading_sensor(room_pano, name):
     # the image compass surface: a tracker's heading sensor takes it like the visual compass
     sensor = make_sensor(name)
@@ -116,7 +144,7 @@ def test_a_saved_sensor_is_a_grid_trackers_heading_sensor(room_pano, tmp_path):
     [
         {"type": "magnetic", "heading_step_deg": 1e-6},  # would be 3.6e8 headings
         {"type": "image_difference", "heading_step_deg": 0.001},
-        {"type": "sector_colour", "el_step_deg": 1e-9},
+        {"type": "sector_color", "el_step_deg": 1e-9},
     ],
 )
 def test_a_config_cannot_make_a_sensor_exhaust_memory(spec):

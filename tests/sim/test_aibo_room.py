@@ -173,6 +173,13 @@ def test_render_human_without_display_is_a_clear_error(monkeypatch):
         gym.make("vc_gym/AiboRoom-v0", render_mode="human")
 
 
+def test_a_step_before_the_first_reset_is_refused():
+    env = make("vc_gym/AiboRoom-v0")
+    with pytest.raises(RuntimeError, match="reset"):
+        env.unwrapped.step(np.zeros(5, np.float32))
+    env.close()
+
+
 def test_close_is_idempotent_and_closed_env_refuses():
     env = make("vc_gym/AiboRoom-v0")
     env.reset(seed=0)
@@ -222,10 +229,17 @@ def test_bad_arguments(kwargs):
         gym.make("vc_gym/AiboRoom-v0", **kwargs)
 
 
-@pytest.mark.parametrize("pose", [(100.0, 100.0, 0.0), (0.0, -3.48, 0.0), (np.nan, 0.0, 0.0)])
-def test_a_pose_outside_the_walls_is_refused(pose):
+@pytest.mark.parametrize(
+    ("pose", "message"),
+    [
+        ((100.0, 100.0, 0.0), "pose .* inside the walls"),
+        ((0.0, -3.48, 0.0), "pose .* inside the walls"),
+        ((np.nan, 0.0, 0.0), "pose must be 3 finite"),
+    ],
+)
+def test_a_pose_outside_the_walls_is_refused(pose, message):
     env = make("vc_gym/AiboRoom-v0")
-    with pytest.raises(ValueError, match="pose"):
+    with pytest.raises(ValueError, match=message):
         env.reset(seed=0, options={"pose": pose})
     env.reset(seed=0, options={"pose": (3.3, -3.3, 10.0)})  # near a corner, inside: fine
     env.close()
@@ -236,7 +250,7 @@ def test_bad_actions():
     env.reset(seed=0)
     with pytest.raises(ValueError):
         env.step(np.zeros(4, np.float32))
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="finite"):
         env.step(np.array([np.nan, 0, 0, 0, 0], np.float32))
     env.step(np.full(5, 7.0, np.float32))  # out of range is clipped, not an error
     env.close()
@@ -316,7 +330,7 @@ def test_marker_appears_at_pinhole_column(body_yaw, pan):
 
 
 def test_odometry_drift_matches_configured_noise():
-    from vc_gym.sim.robot import OdometryNoise
+    from vc_gym.sim.odometry import OdometryNoise
 
     noise = OdometryNoise(trans_scale=0.1, rot_scale=0.0, trans_std=0.0, rot_std=0.0)
     env = make("vc_gym/AiboRoom-v0", locomotion="kinematic", odometry_noise=noise)
@@ -368,7 +382,7 @@ def test_a_lost_physics_server_is_a_clear_error_and_reset_rebuilds_the_world():
     env.unwrapped.client.disconnect()  # as if the server had died
     with pytest.raises(RuntimeError, match="physics server is gone"):
         env.step(np.zeros(5, np.float32))
-    again, _ = env.reset(seed=3)  # used to fail: the env had to be made anew
+    again, _ = env.reset(seed=3)  # the same env starts a new server: no need to make it anew
     np.testing.assert_array_equal(first["image"], again["image"])
     env.step(np.zeros(5, np.float32))
     env.close()

@@ -10,11 +10,11 @@ import pytest
 from pybullet_utils import bullet_client
 
 from vc_gym.angles import wrap180
+from vc_gym.sim.odometry import OdometryNoise
 from vc_gym.sim.robot import (
     BODY_HEIGHT_M,
     LOCOMOTION_MODES,
     ROBOT_RADIUS_M,
-    OdometryNoise,
     Quadruped,
 )
 
@@ -355,3 +355,14 @@ def test_bad_arguments_raise(bc):
 def test_odometry_noise_validates(field, value):
     with pytest.raises(ValueError, match=field):
         OdometryNoise(**{field: value})
+
+
+def test_names_moved_out_of_robot_stay_importable():
+    import vc_gym.sim
+    from vc_gym.sim import gait, odometry, robot
+
+    assert robot.OdometryNoise is odometry.OdometryNoise is vc_gym.sim.OdometryNoise
+    assert robot.BODY_HEIGHT_M == gait.BODY_HEIGHT_M
+    for module in (robot, vc_gym.sim):
+        for name in module.__all__:
+            assert hasattr(module, name), (module.__name__, name)

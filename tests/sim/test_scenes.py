@@ -169,7 +169,7 @@ def test_bad_arguments(bc):
 
 def test_making_and_closing_envs_keeps_no_python_memory():
     # pybullet keeps every list given as a mesh's vertices, uvs, normals or indices:
-    # each make/reset/close cycle used to leave ~20 KB of them behind
+    # unless they are freed, each make/reset/close cycle leaves ~20 KB of them behind
     import gc
     import tracemalloc
 

@@ -185,7 +185,7 @@ def test_ppo_in_worker_processes_collects_asynchronously_by_default():
     assert TrainConfig().collector == "async"
     assert TrainConfig(vec_env="dummy").collector == "lockstep"  # vc-gym train --n-envs 1
     assert TrainConfig(algo="sac").collector == "lockstep"
-    # a config.json saved before the choice existed was trained in lockstep
+    # a config.json without the choice was trained in lockstep
     saved = {k: v for k, v in TrainConfig().to_dict().items() if k != "collector"}
     assert TrainConfig.from_dict(saved).collector == "lockstep"
     # the shipped policy's config is one of those

@@ -18,8 +18,8 @@ def test_config_file_and_command_line(tmp_path):
     config = read_train_config(cfg, timesteps=500)
     assert config.net_arch == (32, 32) and config.learning_rate == 0.001
     assert config.scene == "office" and config.timesteps == 500 and config.gamma == 0.99
-    # fields a settings file leaves out take today's defaults (a saved config.json's
-    # take the values of its era, test_stops_are_checked_in_training...)
+    # fields a settings file leaves out take the defaults (a saved config.json's take
+    # the values that turn their feature off, test_stops_are_checked_in_training...)
     assert config.confirm_stop_m == 0.25 and config.collector == "async"
     # a run's own config.json reads back as the same config
     saved = tmp_path / "config.json"
@@ -74,7 +74,7 @@ def test_stops_are_checked_in_training_and_old_configs_keep_their_final_stops():
     final = replace(TINY, confirm_stop_m=None)
     assert "confirm_stop_m" not in final.env_kwargs()
     assert TrainConfig.from_dict(final.to_dict()) == final
-    # a config.json written before the field existed: its stops were final
+    # a config.json without the field: its stops are final
     saved_before = {k: v for k, v in final.to_dict().items() if k != "confirm_stop_m"}
     assert TrainConfig.from_dict(saved_before) == final
 
@@ -88,7 +88,7 @@ def test_optional_env_settings_and_old_configs_without_them(name, value):
     plain = replace(TINY, **{name: 0.0})
     assert name not in plain.env_kwargs()
     assert TrainConfig.from_dict(plain.to_dict()) == plain
-    # a config.json written before the field existed: trained without it
+    # a config.json without the field: trained without it
     saved_before = {k: v for k, v in plain.to_dict().items() if k != name}
     assert TrainConfig.from_dict(saved_before) == plain
     # what the agent's env is built with
@@ -121,7 +121,7 @@ def test_goal_correction_settings():
     assert given.env_kwargs()["home_offset_m"] == [0.05, -0.1]
     assert TrainConfig.from_dict(json.loads(json.dumps(given.to_dict()))) == given
     assert "home_offset_m" not in TINY.env_kwargs()
-    # a config.json written before the fields existed: trained towards the tracker's home
+    # a config.json without the fields: trained towards the tracker's home
     saved_before = {
         k: v for k, v in TrainConfig().to_dict().items() if not k.startswith("home_offset")
     }

@@ -248,7 +248,7 @@ def test_agents_experiment_compares_on_the_same_kidnappings(trained, tmp_path, c
 def test_a_bad_scene_or_tracker_in_a_config_file_fails_before_the_run_folder(
     tmp_path, capsys, field, value
 ):
-    # used to crash the workers and leave a folder behind
+    # refused before any worker starts and before the run folder is made
     cfg = tmp_path / "bad.json"
     cfg.write_text(json.dumps({field: value, "timesteps": 64}))
     out = tmp_path / "run"
@@ -346,7 +346,7 @@ def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
     obs, _ = env.reset(seed=3)
     assert agent.predict(obs).shape == (3,)
     env.close()
-    # a config.json saved before the field existed: trained without it
+    # a config.json without the field: trained without it
     before = replace(TINY, previous_action=False).to_dict()  # its env has no such key
     saved_before = {k: v for k, v in before.items() if k != "previous_action"}
     assert TrainConfig.from_dict(saved_before).previous_action is False

@@ -7,7 +7,7 @@ import pytest
 
 from vc_gym.worlds.paint import (
     hsv,
-    random_colour,
+    random_color,
     smooth_noise,
     smoothstep,
     to_uint8,
@@ -37,16 +37,23 @@ def test_hsv_known_values(h: float, s: float, v: float, rgb: tuple[float, float,
     np.testing.assert_allclose(out, rgb, atol=1e-3)
 
 
-def test_random_colour_draws_hue_saturation_value_in_order_from_the_ranges() -> None:
+def test_random_color_draws_hue_saturation_value_in_order_from_the_ranges() -> None:
     rng = np.random.default_rng(5)
-    out = random_colour(rng, s=(0.2, 0.3), v=(0.6, 0.7), h=(0.1, 0.2))
+    out = random_color(rng, s=(0.2, 0.3), v=(0.6, 0.7), h=(0.1, 0.2))
     draws = np.random.default_rng(5).uniform(size=3)
     np.testing.assert_array_equal(
         out, hsv(0.1 + 0.1 * draws[0], 0.2 + 0.1 * draws[1], 0.6 + 0.1 * draws[2])
     )
     for seed in range(20):
-        c = random_colour(np.random.default_rng(seed), s=(0.0, 0.0), v=(0.4, 0.4))
+        c = random_color(np.random.default_rng(seed), s=(0.0, 0.0), v=(0.4, 0.4))
         np.testing.assert_allclose(c, [102.0, 102.0, 102.0], atol=1e-3)  # grey at v
+
+
+def test_random_colour_is_a_deprecated_alias_of_random_color() -> None:
+    from vc_gym.worlds import paint
+
+    with pytest.warns(DeprecationWarning, match="random_color"):
+        assert paint.random_colour is random_color
 
 
 def test_smoothstep() -> None:

@@ -2,32 +2,26 @@
 
 Every command module has ``add_parser(commands)``, which registers its sub-command
 with ``func`` (the function that runs it) and, where an interrupted run can go on,
-``hint`` (what to tell the user after Ctrl-C).
+``hint`` (what to tell the user after Ctrl-C). The command modules are imported by
+:func:`build_parser`, inside :func:`main`'s Ctrl-C handling: importing them takes a
+few seconds, and Ctrl-C then still ends in one line, not a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from collections.abc import Sequence
 
-from vc_gym.cli import bench, check, demo, evaluate, experiment, render, soak, train
-from vc_gym.cli.bench import MAX_BENCH_REPEATS
-from vc_gym.experiments.options import MAX_VIDEOS
+from vc_gym.deprecation import moved_names
 
-__all__ = [
-    "COMMANDS",
-    "EXIT_INTERRUPTED",
-    "MAX_BENCH_REPEATS",
-    "MAX_VIDEOS",
-    "build_parser",
-    "main",
-]
+__all__ = ["COMMANDS", "EXIT_INTERRUPTED", "build_parser", "main"]
 
 #: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
 EXIT_INTERRUPTED = 130
-#: The command modules, in the order ``vc-gym --help`` lists them.
-COMMANDS = (demo, bench, evaluate, train, render, soak, check, experiment)
+#: The command modules of :mod:`vc_gym.cli`, in the order ``vc-gym --help`` lists them.
+COMMANDS = ("demo", "bench", "evaluate", "train", "render", "soak", "check", "experiment")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -43,8 +37,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"vc_gym {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for command in COMMANDS:
-        command.add_parser(commands)
+    for name in COMMANDS:
+        importlib.import_module(f"{__name__}.{name}").add_parser(commands)
     _remember_parsers(parser)
     return parser
 
@@ -61,19 +55,35 @@ def _remember_parsers(parser: argparse.ArgumentParser) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``vc-gym``; returns the exit status."""
-    parser = build_parser()
-    args, unknown = parser.parse_known_args(argv)
-    if unknown:
-        getattr(args, "parser", parser).error(f"unrecognized arguments: {' '.join(unknown)}")
+    args = argparse.Namespace(command=None)
     try:
+        parser = build_parser()
+        args, unknown = parser.parse_known_args(argv)
+        if unknown:
+            getattr(args, "parser", parser).error(f"unrecognized arguments: {' '.join(unknown)}")
         return int(args.func(args))
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
         hint = args.hint(args) if getattr(args, "hint", None) else ""
-        print(f"vc-gym {args.command}: interrupted{hint}", file=sys.stderr)
+        print(f"{_prog(args)}: interrupted{hint}", file=sys.stderr)
         return EXIT_INTERRUPTED
     except (ValueError, FileNotFoundError) as e:
-        print(f"vc-gym {args.command}: error: {e}", file=sys.stderr)
+        print(f"{_prog(args)}: error: {e}", file=sys.stderr)
         return 2
     except RuntimeError as e:  # a failure during the work (a dead worker, a fall, ...)
-        print(f"vc-gym {args.command}: failed: {e}", file=sys.stderr)
+        print(f"{_prog(args)}: failed: {e}", file=sys.stderr)
         return 1
+
+
+def _prog(args: argparse.Namespace) -> str:
+    return f"vc-gym {args.command}" if getattr(args, "command", None) else "vc-gym"
+
+
+#: Constants this package exported, now in the module of what they bound.
+_MOVED = {"MAX_BENCH_REPEATS": "vc_gym.cli.bench", "MAX_VIDEOS": "vc_gym.experiments.options"}
+
+
+def __getattr__(name: str) -> object:
+    # imported on first use: the command modules stay out of ``import vc_gym.cli``
+    if name not in _MOVED:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return moved_names(__name__, {name: importlib.import_module(_MOVED[name])})(name)

@@ -1,4 +1,4 @@
-"""``vc-gym check``: the end-to-end self-test (bad input, hostile files, faults, soak)."""
+"""``vc-gym check``: the end-to-end self-test (hostile files, env misuse, faults, soak)."""
 
 from __future__ import annotations
 
@@ -15,15 +15,16 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     """Add ``check`` to the ``vc-gym`` commands."""
     p = commands.add_parser(
         "check",
-        help="self-test: bad input, hostile files, faults and a short soak (< 5 min)",
+        help="self-test: hostile files, env misuse, faults and a short soak (< 5 min)",
         description=(
-            "Run vc_gym's robustness cases: bad arguments and images, hostile map, model and "
-            "settings files (zip bombs, pickled payloads, bit flips, deep nesting), the same "
-            "misuse of every registered env (bad actions, resets, seeds, use after close), "
-            "faults (killed workers, a lost physics server, a rerun of a finished run), then "
-            "a short "
-            "soak. Prints cases tried, passed and failed (0 expected) and the soak figures; "
-            "the exit status is 1 if a case failed."
+            "Run vc_gym's end-to-end robustness cases on this machine: hostile map, model, "
+            "job and settings files (zip bombs, pickled payloads, bit flips, deep nesting, "
+            "code named in a file), the same misuse of every registered env (bad actions, "
+            "resets, seeds, use after close), faults (killed workers, a lost physics server, "
+            "a rerun of a finished run), commands asked for more than the machine has, then "
+            "a short soak. Prints cases tried, passed and failed (0 expected) and the soak "
+            "figures; the exit status is 1 if a case failed. The checks of single functions' "
+            "arguments are in the unit tests."
         ),
     )
     p.add_argument("--soak-steps", type=int, default=2_000, help="steps of the short soak")

@@ -64,8 +64,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--mode",
         choices=HOMING_MODE_CHOICES,
-        default="check-home",
-        help="how the place is learned and the scripted agent homes: " + HOMING_MODE_HELP,
+        help="how the place is learned and the scripted agent homes (default: check-home; "
+        "paper for a learned agent, whose training places were learned the paper's way): "
+        + HOMING_MODE_HELP,
     )
     add_tracker_option(p)
     p.add_argument(
@@ -84,9 +85,10 @@ def run(args: argparse.Namespace) -> int:
         "episodes": args.episodes,
         "learn_time_s": args.learn_time,
         "max_homing_s": args.max_homing,
-        "mode": args.mode,
         "field": False,
     }
+    if args.mode is not None:
+        options["mode"] = args.mode
     if args.allow_imports:
         options["allow_imports"] = True
     return experiment_command.run_experiment(

@@ -331,8 +331,8 @@ class CompassAtlas:
         home_headings = self._home_headings[:, which]
         d = np.radians(np.asarray(headings_deg)[None, :] - home_headings)
         logw = self._kappa * (np.cos(d) - 1.0)  # (frames, spots)
-        # relative to the nearest home frame: a narrow kernel no longer underflows every
-        # weight to 0 (0 / 0 made the position NaN); the nearest frame weighs 1
+        # relative to the nearest home frame, which weighs 1: even a narrow kernel cannot
+        # underflow every weight to 0 (0 / 0 would make the position NaN)
         w = np.exp(logw - logw.max(axis=0, keepdims=True))
         return (w * self._home_scores[:, which]).sum(axis=0) / w.sum(axis=0)
 

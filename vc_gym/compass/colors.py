@@ -2,8 +2,9 @@
 
 Sturm & Visser (section 3.4) reduce every pixel to one of ``c`` colour classes before
 building the compass signature. The classes are learned by clustering colour space with
-expectation-maximisation (EM) on a Gaussian mixture model; afterwards a pixel is
-classified with a single read of a lookup table over quantised colour.
+expectation-maximisation (EM) on a Gaussian mixture model
+(:mod:`vc_gym.compass.color_mixture`); afterwards a pixel is classified with a single
+read of a lookup table over quantised colour.
 
 Conventions: colours are RGB in ``0..255``; images are ``uint8`` arrays of shape
 ``(H, W, 3)`` (see :func:`vc_gym.images.check_image`). The lookup table has
@@ -19,20 +20,18 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from vc_gym.compass.color_mixture import WeightedGaussians, cholesky3, fit_gaussian_mixture
 from vc_gym.images import check_image
 
 __all__ = ["ColorClasses", "MAX_COLOR_VARIANCE", "MAX_LIGHT_LEVEL", "MIN_COLOR_VARIANCE"]
 
-#: Added to every covariance (in ``(0..255)**2`` units) so that flat image regions do not
-#: give singular covariances.
-_COV_REG = 1.0
 #: Smallest pivot of a class covariance's Cholesky factor (its variance along each axis
 #: given the ones before, ``(0..255)**2`` units). Fitted classes have at least
-#: ``_COV_REG``; far below, the closed-form inverse overflows and the lookup table
-#: comes out of NaNs.
+#: :data:`~vc_gym.compass.color_mixture.COV_REG`; far below, the closed-form inverse
+#: overflows and the lookup table comes out of NaNs.
 MIN_COLOR_VARIANCE = 1e-3
 #: Largest variance of a class along a channel: a standard deviation of the whole
-#: colour range (fitted classes stay below ``127.5**2 + _COV_REG``).
+#: colour range (fitted classes stay below ``127.5**2 + COV_REG``).
 MAX_COLOR_VARIANCE = 255.0**2
 #: Range of a class mean, per channel: the colour range of a ``uint8`` image (a mean
 #: outside it only takes colours away from the other classes), give or take rounding
@@ -42,14 +41,6 @@ _COLOR_RANGE_SLACK = 1e-6
 #: Largest mean linear light level (:func:`vc_gym.exposure.mean_linear_level`, 1 for a
 #: white frame), give or take the rounding of a float32 mean.
 MAX_LIGHT_LEVEL = 1.0 + 1e-6
-#: Smallest weight a mixture component keeps; a component that loses all its samples is
-#: kept with (about) this weight instead of producing a zero or NaN.
-_MIN_WEIGHT = 1e-12
-#: A component whose summed responsibility falls below this is "dead": its mean and
-#: covariance are frozen at their previous values.
-_DEAD_NK = 1e-3
-#: Number of Lloyd (k-means) iterations after k-means++ seeding.
-_KMEANS_ITER = 20
 #: Cells times components evaluated per chunk when building the LUT (cache-sized).
 _LUT_CHUNK_ELEMS = 1 << 16
 #: Luminance weights (ITU-R BT.601) used to order the classes.
@@ -99,186 +90,6 @@ def _int_scalar(name: str, value: object) -> int:
             f"{name} must be a 0-d integer array, got dtype {arr.dtype} and shape {arr.shape}"
         )
     return int(arr)
-
-
-# --------------------------------------------------------------------------------------
-# Gaussian algebra, written with elementwise operations only (3x3, closed form) so that
-# the results are bit-for-bit reproducible and independent of LAPACK/BLAS
-# --------------------------------------------------------------------------------------
-
-
-def _cholesky3(cov: np.ndarray) -> np.ndarray | None:
-    """Batched lower Cholesky factor of ``(c, 3, 3)`` matrices, or None if not PD."""
-    a = cov
-    with np.errstate(invalid="ignore", divide="ignore"):
-        p0 = a[:, 0, 0]
-        l00 = np.sqrt(p0)
-        l10 = a[:, 1, 0] / l00
-        l20 = a[:, 2, 0] / l00
-        p1 = a[:, 1, 1] - l10 * l10
-        l11 = np.sqrt(p1)
-        l21 = (a[:, 2, 1] - l20 * l10) / l11
-        p2 = a[:, 2, 2] - l20 * l20 - l21 * l21
-        l22 = np.sqrt(p2)
-    pivots = np.stack([p0, p1, p2], axis=1)
-    if not np.all(np.isfinite(pivots)) or not np.all(pivots > 0):
-        return None
-    zero = np.zeros_like(l00)
-    return np.stack(
-        [
-            np.stack([l00, zero, zero], axis=1),
-            np.stack([l10, l11, zero], axis=1),
-            np.stack([l20, l21, l22], axis=1),
-        ],
-        axis=1,
-    )
-
-
-def _tri_inv3(chol: np.ndarray) -> np.ndarray:
-    """Batched inverse of lower-triangular ``(c, 3, 3)`` matrices (closed form)."""
-    l00, l11, l22 = chol[:, 0, 0], chol[:, 1, 1], chol[:, 2, 2]
-    l10, l20, l21 = chol[:, 1, 0], chol[:, 2, 0], chol[:, 2, 1]
-    inv = np.zeros_like(chol)
-    inv[:, 0, 0] = 1.0 / l00
-    inv[:, 1, 1] = 1.0 / l11
-    inv[:, 2, 2] = 1.0 / l22
-    inv[:, 1, 0] = -l10 / (l00 * l11)
-    inv[:, 2, 1] = -l21 / (l11 * l22)
-    inv[:, 2, 0] = (l10 * l21 - l11 * l20) / (l00 * l11 * l22)
-    return inv
-
-
-class _Gaussians:
-    """Precomputed quantities for evaluating ``log w_k + log N(x | mu_k, Sigma_k)``."""
-
-    def __init__(self, means: np.ndarray, chol: np.ndarray, weights: np.ndarray) -> None:
-        self.means = means
-        self.prec_chol = _tri_inv3(chol)  # L^-1, so maha = |L^-1 (x - mu)|^2
-        half_logdet = np.log(chol[:, 0, 0]) + np.log(chol[:, 1, 1]) + np.log(chol[:, 2, 2])
-        with np.errstate(divide="ignore"):
-            log_w = np.log(weights)
-        # constant term of log w_k + log N(x | mu_k, Sigma_k), without the 1.5 log 2 pi
-        self.offset = log_w - half_logdet
-
-    def weighted_log_density(self, xt: np.ndarray) -> np.ndarray:
-        """``(3, N)`` float colours -> ``(c, N)`` of ``log w_k + log N(x_n | k) + 1.5 log 2pi``.
-
-        Component-major layout keeps every numpy inner loop ``N`` long (fast for small c).
-        """
-        m, a = self.means[:, :, None], self.prec_chol[:, :, :, None]
-        d0 = xt[0] - m[:, 0]
-        d1 = xt[1] - m[:, 1]
-        d2 = xt[2] - m[:, 2]
-        y0 = a[:, 0, 0] * d0
-        y1 = a[:, 1, 0] * d0 + a[:, 1, 1] * d1
-        y2 = a[:, 2, 0] * d0 + a[:, 2, 1] * d1 + a[:, 2, 2] * d2
-        maha = y0 * y0 + y1 * y1 + y2 * y2
-        return self.offset[:, None] - 0.5 * maha
-
-
-# --------------------------------------------------------------------------------------
-# fitting: k-means++ initialisation and EM for a full-covariance GMM. Samples are kept
-# channel-major, ``xt`` of shape (3, N); per-sample quantities are (c, N).
-# --------------------------------------------------------------------------------------
-
-
-def _sq_dist(xt: np.ndarray, centres: np.ndarray) -> np.ndarray:
-    """Squared Euclidean distances ``(3, N) x (k, 3) -> (k, N)``."""
-    d = xt[0] - centres[:, 0:1]
-    out = d * d
-    for j in (1, 2):
-        d = xt[j] - centres[:, j : j + 1]
-        out += d * d
-    return out
-
-
-def _kmeans_pp(xt: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
-    """k-means++ seeding followed by a few Lloyd iterations; returns ``(k, 3)`` centres."""
-    n = xt.shape[1]
-    centres = np.empty((k, 3))
-    centres[0] = xt[:, rng.integers(n)]
-    closest = _sq_dist(xt, centres[0:1])[0]
-    for i in range(1, k):
-        total = closest.sum()
-        if total > 0:
-            idx = rng.choice(n, p=closest / total)
-        else:  # every sample already coincides with a centre (few distinct colours)
-            idx = rng.integers(n)
-        centres[i] = xt[:, idx]
-        np.minimum(closest, _sq_dist(xt, centres[i : i + 1])[0], out=closest)
-    for _ in range(_KMEANS_ITER):
-        labels = np.argmin(_sq_dist(xt, centres), axis=0)
-        counts = np.bincount(labels, minlength=k)
-        sums = np.stack([np.bincount(labels, weights=xt[j], minlength=k) for j in range(3)], 1)
-        alive = counts > 0
-        new = centres.copy()  # an empty cluster keeps its centre
-        new[alive] = sums[alive] / counts[alive, None]
-        if np.array_equal(new, centres):
-            break
-        centres = new
-    return centres
-
-
-def _m_step(
-    xt: np.ndarray, resp: np.ndarray, old_means: np.ndarray, old_covs: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Weights, means and regularised covariances from responsibilities ``(c, N)``.
-
-    A component with (almost) no responsibility keeps ``old_means``/``old_covs``.
-    """
-    c, n = resp.shape
-    nk = resp.sum(axis=1)
-    dead = nk < _DEAD_NK
-    safe_nk = np.where(dead, 1.0, nk)
-    means = (resp @ xt.T) / safe_nk[:, None]
-    covs = np.empty((c, 3, 3))
-    d = [xt[j] - means[:, j : j + 1] for j in range(3)]
-    rd = [resp * dj for dj in d]
-    for i in range(3):
-        for j in range(i + 1):
-            v = np.einsum("kn,kn->k", rd[i], d[j]) / safe_nk
-            covs[:, i, j] = v
-            covs[:, j, i] = v
-    covs[:, [0, 1, 2], [0, 1, 2]] += _COV_REG
-    means[dead] = old_means[dead]
-    covs[dead] = old_covs[dead]
-    weights = np.maximum(nk / n, _MIN_WEIGHT)
-    weights /= weights.sum()
-    return weights, means, covs
-
-
-def _logsumexp_cols(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Log-sum-exp over components of ``(c, N)`` and the normalised responsibilities."""
-    amax = a.max(axis=0)
-    e = np.exp(a - amax)
-    s = e.sum(axis=0)
-    return np.log(s) + amax, e / s
-
-
-def _em(
-    xt: np.ndarray, k: int, rng: np.random.Generator, max_iter: int, tol: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    centres = _kmeans_pp(xt, k, rng)
-    labels = np.argmin(_sq_dist(xt, centres), axis=0)
-    n = xt.shape[1]
-    resp = np.zeros((k, n))
-    resp[labels, np.arange(n)] = 1.0
-    weights, means, covs = _m_step(
-        xt, resp, centres, np.broadcast_to(_COV_REG * np.eye(3), (k, 3, 3))
-    )
-    prev_ll = -np.inf
-    for _ in range(max_iter):
-        chol = _cholesky3(covs)
-        if chol is None:  # cannot happen with the regularisation; guard against NaN anyway
-            raise FloatingPointError("covariance lost positive definiteness during EM")
-        log_prob = _Gaussians(means, chol, weights).weighted_log_density(xt)
-        log_norm, resp = _logsumexp_cols(log_prob)
-        ll = float(log_norm.mean())
-        weights, means, covs = _m_step(xt, resp, means, covs)
-        if abs(ll - prev_ll) < tol:
-            break
-        prev_ll = ll
-    return weights, means, covs
 
 
 # --------------------------------------------------------------------------------------
@@ -370,7 +181,7 @@ class ColorClasses:
         if not np.allclose(cov, cov.transpose(0, 2, 1), rtol=1e-9, atol=1e-9 * scale):
             raise ValueError(f"{prefix}covariances must be symmetric")
         cov = 0.5 * (cov + cov.transpose(0, 2, 1))
-        chol = _cholesky3(cov)
+        chol = cholesky3(cov)
         if chol is None:
             raise ValueError(f"{prefix}covariances must be positive definite")
         pivots = chol[:, [0, 1, 2], [0, 1, 2]] ** 2
@@ -400,12 +211,12 @@ class ColorClasses:
         self.means = mu
         self.covariances = cov
         self.weights = w
-        self.lut = self._build_lut(_Gaussians(mu, chol, w))
+        self.lut = self._build_lut(WeightedGaussians(mu, chol, w))
         for arr in (self.means, self.covariances, self.weights, self.lut):
             arr.setflags(write=False)
         self._shift = 8 - self.bits
 
-    def _build_lut(self, gauss: _Gaussians) -> np.ndarray:
+    def _build_lut(self, gauss: WeightedGaussians) -> np.ndarray:
         bits = self.bits
         n_side = 1 << bits
         centres_1d = (np.arange(n_side) + 0.5) * float(1 << (8 - bits))
@@ -499,13 +310,12 @@ class ColorClasses:
         pixels = np.concatenate([im.reshape(-1, 3) for im in checked])
         if pixels.shape[0] > max_samples:
             pixels = pixels[rng.choice(pixels.shape[0], size=max_samples, replace=False)]
-        xt = np.ascontiguousarray(pixels.T, dtype=np.float64)
+        mixture = fit_gaussian_mixture(pixels, n_colors, rng=rng, max_iter=max_iter, tol=tol)
 
-        weights, means, covs = _em(xt, n_colors, rng, max_iter, float(tol))
-
+        means = mixture.means
         luma = means @ _LUMA
         order = np.lexsort((means[:, 2], means[:, 1], means[:, 0], luma))
-        return cls(means[order], covs[order], weights[order], bits=bits)
+        return cls(means[order], mixture.covariances[order], mixture.weights[order], bits=bits)
 
     # ---------------------------------------------------------------- classification
 
@@ -607,7 +417,7 @@ class ColorClasses:
             bits,
             prefix=_PREFIX,
         )
-        ref = arrays.get(_PREFIX + "exposure_reference")  # absent in older files
+        ref = arrays.get(_PREFIX + "exposure_reference")  # optional: without it, no reference (0)
         if ref is not None:
             ref = _real_array(_PREFIX + "exposure_reference", ref, ())
             if not 0 <= ref <= MAX_LIGHT_LEVEL:

@@ -18,12 +18,14 @@ is scaled before it is classified:
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from vc_gym.compass.light_map import LightMap
 from vc_gym.compass.scan_geometry import ScanGeometry
+from vc_gym.deprecation import moved_names
 from vc_gym.exposure import (
     GAIN_STEP_STOPS,
     column_levels,
@@ -34,7 +36,7 @@ from vc_gym.exposure import (
 
 __all__ = [
     "REFERENCE_EXPOSURES",
-    "colour_fitting_levels",
+    "color_fitting_levels",
     "exposure_corrected",
     "frame_gain_of",
     "heading_gain_steps",
@@ -57,10 +59,17 @@ def upper_half(image: np.ndarray) -> np.ndarray:
     return image[: max(image.shape[0] // 2, 1)]
 
 
-def colour_fitting_levels(images: Sequence[np.ndarray]) -> list[float]:
+def color_fitting_levels(images: Sequence[np.ndarray]) -> list[float]:
     """Mean linear light level of the :func:`upper_half` of each colour-fitting image;
     their mean is the reference level of ``exposure="mean"`` and ``"session"``."""
     return [mean_linear_level(upper_half(im)) for im in images]
+
+
+# deprecated: colour_fitting_levels, the British spelling of color_fitting_levels, served
+# for one release
+__getattr__ = moved_names(
+    __name__, {"colour_fitting_levels": (sys.modules[__name__], "color_fitting_levels")}
+)
 
 
 def scaled_to_reference(pixels: np.ndarray, level: float, reference: float) -> np.ndarray:

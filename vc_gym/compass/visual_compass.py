@@ -27,7 +27,7 @@ from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.features import column_transition_counts
 from vc_gym.compass.light_gain import (
     REFERENCE_EXPOSURES,
-    colour_fitting_levels,
+    color_fitting_levels,
     exposure_corrected,
     frame_gain_of,
     heading_gain_steps,
@@ -238,7 +238,7 @@ class VisualCompass:
         ref = 0.0
         if self.config.exposure in REFERENCE_EXPOSURES:
             # reference level from the upper halves (what the compass scans at pitch 0)
-            levels = colour_fitting_levels(images)
+            levels = color_fitting_levels(images)
             ref = float(np.mean(levels))
             if ref <= 0:
                 raise ValueError(

@@ -104,9 +104,9 @@ def atlas_spec(
         spec["spot"] = [float(v) for v in spot]
     if spots is not None:
         spec["spots"] = spots
-    if around_m:  # only when set: earlier grid specs keep their keys
+    if around_m:  # only when set, so that it changes no other grid spec's atlas key
         spec["around_m"] = float(around_m)
-    if learning:  # only when set: the paper's specs keep their keys
+    if learning:  # only when set, so that it changes no paper spec's atlas key
         spec["learning"] = learning
     json.dumps(spec, allow_nan=False)  # JSON values only
     return spec

@@ -32,7 +32,9 @@ from vc_gym.localization import TrackerSpec
 __all__ = [
     "DEFAULT_HOMING_MODE",
     "HOMING_MODES",
+    "LEARNED_AGENT_MODE",
     "canonical_homing_mode",
+    "default_homing_mode",
     "LEARNED_CONFIRM_STOP_M",
     "EpisodeRecord",
     "HomingMode",
@@ -189,8 +191,18 @@ HOMING_MODES: dict[str, HomingMode] = {
 }
 #: The homing mode of the demo, ``vc-gym evaluate`` and every experiment unless told.
 DEFAULT_HOMING_MODE = "check-home"
+#: The mode a learned agent homes in unless told: the one whose places it trained on
+#: (``vc-gym train`` learns its places the paper's way).
+LEARNED_AGENT_MODE = "paper"
 #: Deprecated names of homing modes, accepted with a ``DeprecationWarning``.
 DEPRECATED_HOMING_MODES = {"improved": "check-home"}
+
+
+def default_homing_mode(agent: str) -> str:
+    """The homing mode for ``agent`` when none is given: :data:`DEFAULT_HOMING_MODE` for
+    the scripted agent, :data:`LEARNED_AGENT_MODE` for a learned one (a policy is
+    evaluated in places learned the way its training places were)."""
+    return DEFAULT_HOMING_MODE if agent == "scripted" else LEARNED_AGENT_MODE
 
 
 def canonical_homing_mode(mode: object) -> str:
@@ -227,7 +239,7 @@ def make_homing_run(
     max_homing_s: float = 60.0,
     learner: Callable | None = None,
     keep_image: bool = False,
-    mode: str = DEFAULT_HOMING_MODE,
+    mode: str | None = None,
     policy: dict[str, Any] | None = None,
     allow_imports: bool = False,
 ) -> HomingRun:
@@ -255,7 +267,9 @@ def make_homing_run(
         env instead, see :class:`~vc_gym.experiments.video.EpisodeVideo`).
     mode : str
         How the place is learned and how the scripted agent homes
-        (:data:`HOMING_MODES`): ``"check-home"`` (default) or ``"paper"``. With a saved atlas
+        (:data:`HOMING_MODES`): ``"check-home"`` or ``"paper"``; default
+        :func:`default_homing_mode` (check-home for the scripted agent, paper for a
+        learned one). With a saved atlas
         (``learner``) only the policy part applies; the atlas brings its own learning.
     policy : dict, optional
         More keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`,
@@ -264,7 +278,7 @@ def make_homing_run(
         Let a learned agent's ``config.json`` name its tracker by import path (imports
         that module; :class:`~vc_gym.agents.learned.LearnedHomingAgent`).
     """
-    chosen = homing_mode(mode)
+    chosen = homing_mode(default_homing_mode(agent) if mode is None else mode)
     policy_kwargs = {**chosen.policy, **(policy or {})}
     task: dict[str, Any] = {
         "scene": scene,

@@ -49,7 +49,7 @@ MAX_VIDEOS = 1_000
 #: The values ``--mode`` takes: the homing modes and a deprecated name.
 HOMING_MODE_CHOICES = ("check-home", "paper", "improved")
 HOMING_MODE_HELP = (
-    "check-home (default): the spots normalised with the frames of the first turn at "
+    "check-home: the spots normalised with the frames of the first turn at "
     "the true home, and home checked with a full turn before stopping; paper: the "
     "paper's procedure (normalised after walking back home by odometry, stop where "
     "the estimate says home); improved: deprecated name of check-home"
@@ -212,7 +212,7 @@ OPTIONS: dict[str, Option] = {
         "sensor",
         "--sensor",
         "the grid tracker's heading sensor, learned in a turn at home for every learning "
-        "seed (position still from the atlas): feature, image_difference, sector_colour, "
+        "seed (position still from the atlas): feature, image_difference, sector_color, "
         "visual_compass, or magnetic (a magnetometer in the head; see `vc-gym experiment "
         "sensors`)",
         metavar="NAME",
@@ -273,7 +273,9 @@ OPTIONS: dict[str, Option] = {
     "mode": Option(
         "mode",
         "--mode",
-        "how the place is learned and the scripted agent homes: " + HOMING_MODE_HELP,
+        "how the place is learned and the scripted agent homes (default: check-home; "
+        "paper for a learned agent, whose training places were learned the paper's way): "
+        + HOMING_MODE_HELP,
         choices=HOMING_MODE_CHOICES,
     ),
     "modes": Option(

@@ -192,7 +192,7 @@ def evaluate_rotation_set(
         per crop and the crop details.
     """
 
-    def fit_colours(sensor: VisualCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
+    def fit_colors(sensor: VisualCompass, frames: list[tuple[np.ndarray, Camera]]) -> None:
         sensor.fit_colors([image for image, _ in frames])
 
     def errors(session_gain: bool) -> tuple[VisualCompass, dict[str, Any]]:
@@ -202,7 +202,7 @@ def evaluate_rotation_set(
             vc,
             crop_width_frac=crop_width_frac,
             crops_per_photo=crops_per_photo,
-            setup=fit_colours,
+            setup=fit_colors,
             light=light,
             session_gain=session_gain,
         )

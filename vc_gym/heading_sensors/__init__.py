@@ -7,7 +7,7 @@ experiments take them (``vc-gym experiment sensors``):
 
 * :class:`ImageDifferenceCompass` — the rotational image difference (Zeil et al.;
   Labrosse's visual compass), every shift at once by FFT;
-* :class:`SectorColourCompass` — mean colour per sector (Porta & Kröse);
+* :class:`SectorColorCompass` — mean colour per sector (Porta & Kröse);
 * :class:`FeatureCompass` — ORB keypoints learned with their direction;
 * :class:`NoisyMagneticCompass` — a magnetometer: true heading, noise and a local
   disturbance field (no camera).
@@ -21,6 +21,8 @@ tracker with a saved image sensor as its heading sensor.
 >>> sensor.estimate(new_image, Camera()).heading_deg                 # doctest: +SKIP
 """
 
+from vc_gym.deprecation import moved_names
+from vc_gym.heading_sensors import sector_color as _sector_color
 from vc_gym.heading_sensors.base import BaselineCompass, FrameScore
 from vc_gym.heading_sensors.feature import FeatureCompass
 from vc_gym.heading_sensors.image_difference import ImageDifferenceCompass
@@ -29,8 +31,14 @@ from vc_gym.heading_sensors.magnetic import (
     MagnetometerCompass,
     NoisyMagneticCompass,
 )
-from vc_gym.heading_sensors.registry import SENSORS, make_sensor, register_sensor
-from vc_gym.heading_sensors.sector_color import SectorColourCompass
+from vc_gym.heading_sensors.registry import (
+    DEPRECATED_SENSOR_NAMES,
+    SENSORS,
+    current_sensor_name,
+    make_sensor,
+    register_sensor,
+)
+from vc_gym.heading_sensors.sector_color import SectorColorCompass
 from vc_gym.heading_sensors.strip import StripGrid, angular_strip
 from vc_gym.heading_sensors.tracking import (
     IMAGE_SENSORS,
@@ -40,6 +48,7 @@ from vc_gym.heading_sensors.tracking import (
 )
 
 __all__ = [
+    "DEPRECATED_SENSOR_NAMES",
     "IMAGE_SENSORS",
     "SENSORS",
     "SENSOR_GRID",
@@ -50,11 +59,16 @@ __all__ = [
     "ImageDifferenceCompass",
     "MagnetometerCompass",
     "NoisyMagneticCompass",
-    "SectorColourCompass",
+    "SectorColorCompass",
     "StripGrid",
     "angular_strip",
+    "current_sensor_name",
     "load_sensor",
     "make_sensor",
     "register_sensor",
     "sensor_grid_tracker",
 ]
+
+# deprecated: SectorColourCompass, the British spelling of SectorColorCompass, served for
+# one release
+__getattr__ = moved_names(__name__, {"SectorColourCompass": (_sector_color, "SectorColorCompass")})

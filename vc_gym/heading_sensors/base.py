@@ -99,6 +99,9 @@ class BaselineCompass(ABC):
 
     #: File schema name (``.npz`` entry ``schema``); one per class.
     schema: ClassVar[str] = ""
+    #: Other schema names :meth:`load` accepts as this class' files (another spelling
+    #: of :attr:`schema`).
+    legacy_schemas: ClassVar[tuple[str, ...]] = ()
     #: Version of the class' file layout.
     schema_version: ClassVar[int] = 1
     #: Short name of the sensor (as in :data:`vc_gym.heading_sensors.SENSORS`).
@@ -224,7 +227,9 @@ class BaselineCompass(ABC):
             (one the constructor refuses, or whose map cannot be allocated) or arrays
             that do not fit it.
         """
-        arrays = load_npz_checked(path, cls.schema, cls.schema_version)
+        arrays = load_npz_checked(
+            path, cls.schema, cls.schema_version, legacy_schemas=cls.legacy_schemas
+        )
         config = read_json_array(arrays, "config", path) if "config" in arrays else None
         if not isinstance(config, dict):
             raise MapFileError(f"{path}: no config object")

@@ -7,6 +7,7 @@ the visual compass itself (``"visual_compass"``, its
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -14,10 +15,18 @@ from vc_gym.compass import CompassConfig, ImageCompass, VisualCompass
 from vc_gym.heading_sensors.feature import FeatureCompass
 from vc_gym.heading_sensors.image_difference import ImageDifferenceCompass
 from vc_gym.heading_sensors.magnetic import NoisyMagneticCompass
-from vc_gym.heading_sensors.sector_color import SectorColourCompass
+from vc_gym.heading_sensors.sector_color import SectorColorCompass
 from vc_gym.plugins import make_plugin, register_plugin
 
-__all__ = ["SENSORS", "SensorSpec", "make_sensor", "register_sensor", "visual_compass"]
+__all__ = [
+    "DEPRECATED_SENSOR_NAMES",
+    "SENSORS",
+    "SensorSpec",
+    "current_sensor_name",
+    "make_sensor",
+    "register_sensor",
+    "visual_compass",
+]
 
 
 def visual_compass(**config: Any) -> VisualCompass:
@@ -30,10 +39,15 @@ def visual_compass(**config: Any) -> VisualCompass:
 SENSORS: dict[str, Callable[..., Any]] = {
     "visual_compass": visual_compass,
     "image_difference": ImageDifferenceCompass,
-    "sector_colour": SectorColourCompass,
+    "sector_color": SectorColorCompass,
     "feature": FeatureCompass,
     "magnetic": NoisyMagneticCompass,
 }
+
+#: Deprecated sensor names and the name each stands for: :func:`make_sensor` and
+#: :func:`~vc_gym.heading_sensors.load_sensor` accept them for one release, with a
+#: ``DeprecationWarning``.
+DEPRECATED_SENSOR_NAMES: dict[str, str] = {"sector_colour": "sector_color"}
 
 SensorSpec = str | Mapping[str, Any] | Callable[[], Any]
 
@@ -42,6 +56,24 @@ def _is_sensor(obj: object) -> bool:
     return isinstance(obj, (ImageCompass, NoisyMagneticCompass)) or (
         hasattr(obj, "heading_log_likelihood") and not isinstance(obj, type)
     )
+
+
+def current_sensor_name(name: Any, stacklevel: int = 2) -> Any:
+    """``name``, or the name a deprecated sensor name stands for (with a
+    ``DeprecationWarning`` pointing ``stacklevel`` frames up, as
+    :func:`warnings.warn`'s); anything else, or a deprecated name registered again, is
+    returned as is."""
+    if not isinstance(name, str) or name in SENSORS:
+        return name
+    new = DEPRECATED_SENSOR_NAMES.get(name)
+    if new is None:
+        return name
+    warnings.warn(
+        f"sensor name {name!r} is deprecated; use {new!r}",
+        DeprecationWarning,
+        stacklevel=stacklevel + 1,
+    )
+    return new
 
 
 def register_sensor(name: str, factory: Callable[..., Any], overwrite: bool = False) -> None:
@@ -56,7 +88,7 @@ def make_sensor(spec: SensorSpec | Any = "visual_compass") -> Any:
     ----------
     spec : str, dict, callable or sensor
         ``"visual_compass"`` (the paper's compass), ``"image_difference"``,
-        ``"sector_colour"``, ``"feature"``, ``"magnetic"`` or a name given to
+        ``"sector_color"``, ``"feature"``, ``"magnetic"`` or a name given to
         :func:`register_sensor`; ``"package.module:factory"``; ``{"type": name,
         **kwargs}`` (e.g. ``{"type": "visual_compass", "exposure": "mean"}``); a
         callable with no arguments; or a sensor, returned as is.
@@ -67,6 +99,11 @@ def make_sensor(spec: SensorSpec | Any = "visual_compass") -> Any:
         An unknown name (the message lists the known ones), bad arguments, or a
         factory that returns no sensor.
     """
+    if isinstance(spec, str):
+        spec = current_sensor_name(spec)
+    elif isinstance(spec, Mapping) and isinstance(spec.get("type"), str):
+        name = current_sensor_name(spec["type"])
+        spec = spec if name == spec["type"] else {**spec, "type": name}
     return make_plugin(
         spec,
         SENSORS,

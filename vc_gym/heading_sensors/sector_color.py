@@ -12,6 +12,7 @@ replaced by one mean colour per sector.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -19,6 +20,7 @@ import numpy as np
 
 from vc_gym.angles import steps_in_circle
 from vc_gym.compass import Camera
+from vc_gym.deprecation import moved_names
 from vc_gym.heading_sensors.base import BaselineCompass, FrameScore
 from vc_gym.heading_sensors.strip import StripGrid, angular_strip, strip_offsets
 from vc_gym.validation import (
@@ -28,9 +30,9 @@ from vc_gym.validation import (
     positive_float_at_most,
 )
 
-__all__ = ["SectorColourCompass", "FEATURES", "MODELS"]
+__all__ = ["SectorColorCompass", "FEATURES", "MODELS"]
 
-#: Feature representations of a sector's mean colour (see :class:`SectorColourCompass`).
+#: Feature representations of a sector's mean colour (see :class:`SectorColorCompass`).
 FEATURES = ("chroma", "rgb")
 #: Per-sector models of the features.
 MODELS = ("gaussian", "histogram")
@@ -70,7 +72,7 @@ def _srgb_to_linear(v: np.ndarray) -> np.ndarray:
     return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
-class SectorColourCompass(BaselineCompass):
+class SectorColorCompass(BaselineCompass):
     """Heading from the mean colour of each azimuth sector of the view.
 
     The full circle of world directions is cut into sectors of ``sector_deg``. A frame
@@ -175,7 +177,7 @@ class SectorColourCompass(BaselineCompass):
 
     Examples
     --------
-    >>> sc = SectorColourCompass()                                  # doctest: +SKIP
+    >>> sc = SectorColorCompass()                                  # doctest: +SKIP
     >>> for img, yaw in training: sc.learn(img, Camera(yaw_deg=yaw))  # doctest: +SKIP
     >>> sc.estimate(new_image, Camera()).heading_deg                # doctest: +SKIP
 
@@ -185,8 +187,9 @@ class SectorColourCompass(BaselineCompass):
     localization", Robotics and Autonomous Systems 54(2):159-164, 2006.
     """
 
-    schema: ClassVar[str] = "vc_gym.SectorColourCompass"
-    name: ClassVar[str] = "sector_colour"
+    schema: ClassVar[str] = "vc_gym.SectorColorCompass"
+    legacy_schemas: ClassVar[tuple[str, ...]] = ("vc_gym.SectorColourCompass",)
+    name: ClassVar[str] = "sector_color"
 
     def __init__(
         self,
@@ -612,3 +615,10 @@ def _float_entry(arrays: Mapping[str, np.ndarray], key: str, shape: tuple[int, .
     if not np.all(np.isfinite(a)):
         raise ValueError(f"entry {key!r} has non-finite values")
     return a.astype(np.float64)
+
+
+# deprecated: SectorColourCompass, the British spelling of SectorColorCompass, served for
+# one release
+__getattr__ = moved_names(
+    __name__, {"SectorColourCompass": (sys.modules[__name__], "SectorColorCompass")}
+)

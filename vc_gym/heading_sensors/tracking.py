@@ -15,7 +15,7 @@ from typing import Any
 
 from vc_gym.compass import ImageCompass, VisualCompass
 from vc_gym.heading_sensors.base import BaselineCompass
-from vc_gym.heading_sensors.registry import SENSORS
+from vc_gym.heading_sensors.registry import SENSORS, current_sensor_name
 from vc_gym.localization import GridTracker
 
 __all__ = ["IMAGE_SENSORS", "SENSOR_GRID", "load_sensor", "sensor_grid_tracker"]
@@ -25,6 +25,7 @@ SENSOR_GRID = f"{__name__}:sensor_grid_tracker"
 
 
 def _loader(name: str) -> Any:
+    name = current_sensor_name(name, stacklevel=3)  # warns the caller of load_sensor
     if name == "visual_compass":
         return VisualCompass
     cls = SENSORS.get(name)

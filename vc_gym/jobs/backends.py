@@ -11,9 +11,12 @@ as a failed attempt instead of hanging the run.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import math
 import multiprocessing as mp
 import os
+import signal
+import threading
 from collections.abc import Iterator, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
@@ -71,8 +74,14 @@ class LocalBackend:
                     initializer=init_worker,
                     initargs=(True, os.getpid()),
                 )
-                # start the workers now, while the environment is single-threaded
-                list(self._executor.map(_noop, range(self.workers)))
+                # start the workers now, while the environment is single-threaded (each
+                # submit spawns one), with Ctrl-C ignored: a worker inherits that across
+                # exec, so one still starting up never prints a KeyboardInterrupt
+                # traceback; its initializer keeps ignoring it and the parent stops it
+                with _sigint_ignored():
+                    started = [self._executor.submit(_noop, i) for i in range(self.workers)]
+                for future in started:
+                    future.result()
             finally:
                 for k, v in saved.items():
                     if v is None:
@@ -184,6 +193,20 @@ def _submit(
 
 def _noop(_: int) -> None:
     return None
+
+
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """SIGINT ignored in this process for the ``with`` block (main thread only: elsewhere
+    Python cannot change signal handlers, and the block runs as it is)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 class RayBackend:

@@ -8,7 +8,8 @@ the robot in a scene, driven by walk and head commands. The tasks built on it
 
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.sim.head_camera import HeadCameraSpec, render_camera
-from vc_gym.sim.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
+from vc_gym.sim.odometry import OdometryNoise
+from vc_gym.sim.robot import LOCOMOTION_MODES, Quadruped
 from vc_gym.sim.scenes import (
     SCENES,
     Scene,

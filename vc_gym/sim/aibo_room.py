@@ -15,7 +15,8 @@ from pybullet_utils import bullet_client
 
 from vc_gym.poses import check_pose
 from vc_gym.sim.head_camera import HeadCameraSpec, render_camera
-from vc_gym.sim.robot import LOCOMOTION_MODES, OdometryNoise, Quadruped
+from vc_gym.sim.odometry import OdometryNoise
+from vc_gym.sim.robot import LOCOMOTION_MODES, Quadruped
 from vc_gym.sim.scenes import Scene, build_scene, check_scene_name
 from vc_gym.sim.top_view import TopView
 from vc_gym.validation import check_action, check_reset_options, positive_float

@@ -5,9 +5,9 @@ pan and a tilt angle that the robot moves at a bounded speed. Three locomotion m
 trade realism for speed and robustness:
 
 ``"dynamic"``
-    Real trot physics: the 12 leg joints follow an open-loop trot (period 0.3 s, 6 cm
-    foot lift, 0.27 m body height, feet 3 cm outside the hips) by motor position
-    control. Forward, sideways and turning motion come from the stance feet sweeping
+    Real trot physics: the 12 leg joints follow an open-loop trot (:mod:`vc_gym.sim.gait`:
+    period 0.3 s, 6 cm foot lift, 0.27 m body height, feet 3 cm outside the hips) by
+    motor position control. Forward, sideways and turning motion come from the stance feet sweeping
     backwards at the body velocity. Like a real walking engine, it ramps the velocity
     towards the command (at most 2 m/s² and 6 rad/s²) and scales a command down when
     its fastest foot would have to sweep faster than 0.5 m/s (only combined fast
@@ -34,13 +34,20 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import pybullet
 import pybullet_data
 
 from vc_gym.angles import wrap360
+from vc_gym.sim.gait import (
+    BODY_HEIGHT_M,
+    FOOT_XY,
+    GAIT_PERIOD_S,
+    arc_displacement,
+    gait_joint_angles,
+)
+from vc_gym.sim.odometry import OdometryNoise
 from vc_gym.validation import finite_float, positive_float
 
 __all__ = [
@@ -63,9 +70,6 @@ LOCOMOTION_MODES = ("dynamic", "constraint", "kinematic")
 #: The robot model (PyBullet's Unitree a1).
 A1_URDF = os.path.join(pybullet_data.getDataPath(), "a1", "a1.urdf")
 
-#: Nominal height of the trunk frame above the floor while standing and walking (m).
-BODY_HEIGHT_M = 0.27
-
 #: Eye position in the trunk frame (m): ahead of the trunk like a head on a short neck,
 #: so that the eye is 0.30 m above the floor when standing (the Aibo's camera height).
 EYE_OFFSET_M = (0.25, 0.0, 0.03)
@@ -84,30 +88,8 @@ DYNAMIC_SIDEWAYS_FACTOR = 1.0
 #: in place at 30-86 deg/s, about 0.8 while also walking forwards).
 DYNAMIC_TURN_FACTOR = 0.9
 
-# ---------------------------------------------------------------- gait and a1 geometry
-_GAIT_PERIOD_S = 0.3
-_FOOT_LIFT_M = 0.06
-_TOE_RADIUS_M = 0.02
-_THIGH_M = 0.2  # thigh and calf have the same length
-_HIP_OFFSET_M = 0.08505  # from the abduction axis to the thigh plane
-# legs in URDF order FR, FL, RR, RL: hip joint positions in the trunk frame, side sign
-_HIP_XY = np.array([[0.183, -0.047], [0.183, 0.047], [-0.183, -0.047], [-0.183, 0.047]])
-_SIDE = np.array([-1.0, 1.0, -1.0, 1.0])
-# feet stand 3 cm outside the thigh planes: a wider stance keeps combined turning and
-# side-stepping from tipping the trot over (measured over 8 s runs of random constant
-# commands, half of the components at their limits: 0 falls in 600, against 2 in 200
-# with the feet under the thighs; 0 falls in 200 runs of 15 s switching abruptly
-# between random commands every 0.5 s)
-_STANCE_WIDEN_M = 0.03
-_FOOT_Y = _HIP_OFFSET_M + _STANCE_WIDEN_M
-# nominal foot position relative to the trunk frame (floor plane)
-_FOOT_XY = _HIP_XY + np.stack([np.zeros(4), _SIDE * _FOOT_Y], axis=1)
-# trot: FR and RL together, FL and RR half a period later
-_PHASE_OFFSET = np.array([0.0, 0.5, 0.5, 0.0])
-_LEGS = [
-    ((float(xy[0]), float(xy[1])), float(side), float(offset))
-    for xy, side, offset in zip(_FOOT_XY, _SIDE, _PHASE_OFFSET, strict=True)
-]
+# ---------------------------------------------------------------- a1 joints and motors
+# (the leg geometry and the trot itself are in vc_gym.sim.gait)
 # joint indices of (abduction, thigh, calf) of each leg, and of the toe links
 _LEG_JOINTS = [1, 3, 4, 6, 8, 9, 11, 13, 14, 16, 18, 19]
 _TOE_LINKS = [5, 10, 15, 20]
@@ -130,95 +112,7 @@ _FALL_TILT_DEG = 60.0
 _FALL_HEIGHT_M = 0.12
 
 
-@dataclass(frozen=True)
-class OdometryNoise:
-    """How wrong the robot's odometry is.
-
-    Parameters
-    ----------
-    trans_scale : float
-        Standard deviation of a per-episode multiplicative scale error on translations,
-        drawn at :meth:`Quadruped.reset`: every reported translation is multiplied by
-        ``1 + N(0, trans_scale)`` (clipped at 0).
-    rot_scale : float
-        The same for rotations.
-    trans_std : float
-        Per-step additive noise on the forward and left components, standard deviation
-        in metres per metre of the step's commanded component.
-    rot_std : float
-        Per-step additive noise on the turn, degrees per degree of the step's turn.
-    slip_std_m : float
-        Per-step additive noise (metres) on forward and left, independent of the motion.
-    """
-
-    trans_scale: float = 0.05
-    rot_scale: float = 0.05
-    trans_std: float = 0.01
-    rot_std: float = 0.02
-    slip_std_m: float = 0.0
-
-    def __post_init__(self) -> None:
-        for name in ("trans_scale", "rot_scale", "trans_std", "rot_std", "slip_std_m"):
-            value = finite_float(name, getattr(self, name))
-            if value < 0:
-                raise ValueError(f"{name} must be >= 0, got {value!r}")
-
-
 # ------------------------------------------------------------------------ helpers
-def _leg_ik(px: float, py: float, pz: float, side: float) -> tuple[float, float, float]:
-    """Joint angles (abduction, thigh, calf) that put a foot at ``(px, py, pz)``.
-
-    The foot position is relative to the leg's hip (abduction) joint in the trunk frame;
-    ``side`` is +1 for a left leg, -1 for a right one. Analytic inverse kinematics of the
-    a1 leg: abduction about x, then thigh and calf about y (both 0.2 m), knee bending
-    backwards. Pure Python: it runs for every leg at every control tick.
-    """
-    l1 = side * _HIP_OFFSET_M
-    zp = -math.sqrt(max(py * py + pz * pz - l1 * l1, 1e-9))
-    q1 = math.atan2(pz, py) - math.atan2(zp, l1)
-    cos_knee = (px * px + zp * zp - 2.0 * _THIGH_M**2) / (2.0 * _THIGH_M**2)
-    q3 = -math.acos(min(max(cos_knee, -1.0), 1.0))
-    q2 = math.atan2(-px, -zp) - 0.5 * q3
-    return q1, q2, q3
-
-
-def _gait_joint_angles(phase: float, vx: float, vy: float, wz: float) -> list[float]:
-    """Leg joint angles (12) of the trot at gait ``phase`` for body velocity (m/s, rad/s).
-
-    Stance feet sweep backwards at the velocity the body should move with (including the
-    rotation about the trunk centre); swing feet return along a raised arc. With no
-    motion commanded the robot stands on all four feet.
-    """
-    moving = abs(vx) + abs(vy) + 0.2 * abs(wz) > 1e-6
-    half = 0.5 * _GAIT_PERIOD_S
-    depth = -(BODY_HEIGHT_M - _TOE_RADIUS_M)
-    angles: list[float] = []
-    for (fx, fy), side, offset in _LEGS:
-        px, py, pz = 0.0, side * _FOOT_Y, depth
-        if moving:
-            s = (phase + offset) % 1.0
-            if s < 0.5:  # stance: straight back at the ground speed, +1/2 .. -1/2
-                along = 0.5 - 2.0 * s
-            else:  # swing: forwards along a raised arc, -1/2 .. +1/2
-                u = 2.0 * s - 1.0
-                along = 0.5 * (1.0 - math.cos(math.pi * u)) - 0.5
-                pz += _FOOT_LIFT_M * math.sin(math.pi * u)
-            # foot velocity relative to the ground-fixed body motion: v + w x r
-            px = along * (vx - wz * fy) * half
-            py += along * (vy + wz * fx) * half
-        angles.extend(_leg_ik(px, py, pz, side))
-    return angles
-
-
-def _arc(vx: float, vy: float, wz: float, t: float) -> tuple[float, float, float]:
-    """Displacement (forward, left, turn rad) after ``t`` s of constant body velocity."""
-    th = wz * t
-    if abs(th) < 1e-9:
-        return vx * t, vy * t, th
-    s, c = math.sin(th), math.cos(th)
-    return (vx * s + vy * (c - 1.0)) / wz, (vx * (1.0 - c) + vy * s) / wz, th
-
-
 def _rotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
     """Rotate vector ``v`` by the quaternion ``q`` (x, y, z, w)."""
     qx, qy, qz, qw = q
@@ -372,9 +266,9 @@ class Quadruped:
         bc.setGravity(0.0, 0.0, -9.81)
         bc.setTimeStep(self._dt)
         # Sorted contact pairs: without this the broadphase's pair order depends on the
-        # history of the client, so an episode's physics differed by ~1e-9 m depending
+        # history of the client, so an episode's physics would differ by ~1e-9 m depending
         # on which episodes ran before it in the same process, and now and then such a
-        # difference flipped a stop decision.
+        # difference would flip a stop decision.
         bc.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
         kinematic = locomotion == "kinematic"
         self.body_id: int = bc.loadURDF(
@@ -476,7 +370,7 @@ class Quadruped:
             body, [x + com[0], y + com[1], BODY_HEIGHT_M + com[2]], q
         )
         bc.resetBaseVelocity(body, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
-        stand = _gait_joint_angles(0.0, 0.0, 0.0, 0.0)
+        stand = gait_joint_angles(0.0, 0.0, 0.0, 0.0)
         self._reset_joints(body, _LEG_JOINTS, [[a] for a in stand], [[0.0]] * 12)
         if self.locomotion != "kinematic":
             self._set_motors(stand)
@@ -639,7 +533,7 @@ class Quadruped:
                 eth * DYNAMIC_TURN_FACTOR,
             )
         else:
-            believed = _arc(vx, vy, wz, elapsed)
+            believed = arc_displacement(vx, vy, wz, elapsed)
         self._add_odometry(*believed)
 
     def _add_odometry(self, dx: float, dy: float, dth: float) -> None:
@@ -669,8 +563,8 @@ class Quadruped:
     def _gait_tick(self, vx: float, vy: float, wz: float) -> None:
         """Advance the gait by one control period and send the leg targets."""
         control_dt = self._ticks_per_control * self._dt
-        self._phase = (self._phase + control_dt / _GAIT_PERIOD_S) % 1.0
-        self._set_motors(_gait_joint_angles(self._phase, vx, vy, wz))
+        self._phase = (self._phase + control_dt / GAIT_PERIOD_S) % 1.0
+        self._set_motors(gait_joint_angles(self._phase, vx, vy, wz))
 
     def _step_dynamic(self, vx: float, vy: float, wz: float, n: int) -> tuple[float, float, float]:
         """Run ``n`` physics steps; returns the executed motion (forward, left, turn rad)."""
@@ -678,8 +572,8 @@ class Quadruped:
         k = self._ticks_per_control
         dt = self._dt
         # the walking engine limits the stride of the fastest foot and the acceleration
-        vfx = vx - wz * _FOOT_XY[:, 1]
-        vfy = vy + wz * _FOOT_XY[:, 0]
+        vfx = vx - wz * FOOT_XY[:, 1]
+        vfy = vy + wz * FOOT_XY[:, 0]
         fastest = float(np.sqrt(vfx * vfx + vfy * vfy).max())
         if fastest > _MAX_FOOT_SPEED:
             shrink = _MAX_FOOT_SPEED / fastest
@@ -769,7 +663,7 @@ class Quadruped:
         n = max(1, math.ceil(duration * self.control_hz - 1e-9))
         h = duration / n
         for _ in range(n):
-            dfx, dfy, dth = _arc(vx, vy, wz, h)
+            dfx, dfy, dth = arc_displacement(vx, vy, wz, h)
             c, s = math.cos(cmd[2]), math.sin(cmd[2])
             dx, dy = c * dfx - s * dfy, s * dfx + c * dfy
             x, y = cmd[0], cmd[1]
@@ -782,14 +676,14 @@ class Quadruped:
             cmd[0] = x + dx
             cmd[1] = y + dy
             cmd[2] += dth
-        self._phase = (self._phase + duration / _GAIT_PERIOD_S) % 1.0
+        self._phase = (self._phase + duration / GAIT_PERIOD_S) % 1.0
         q = _yaw_quat(cmd[2])
         com = _rotate(q, self._com_offset)
         bc, body = self._bc, self.body_id
         bc.resetBasePositionAndOrientation(
             body, [cmd[0] + com[0], cmd[1] + com[1], BODY_HEIGHT_M + com[2]], q
         )
-        legs = _gait_joint_angles(self._phase, vx, vy, wz)
+        legs = gait_joint_angles(self._phase, vx, vy, wz)
         self._reset_joints(body, _LEG_JOINTS, [[a] for a in legs])
 
     @staticmethod

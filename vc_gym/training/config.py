@@ -401,7 +401,7 @@ class TrainConfig:
 
         A field missing from a saved config reads as the value that turns its feature
         off (final stops, no closeness bonus or minimum walk, no previous action, the
-        tracker's home, lockstep rollouts), not as today's default; each field of
+        tracker's home, lockstep rollouts), not as the field's default; each field of
         :class:`TrainConfig` says which.
         """
         data = dict(data)

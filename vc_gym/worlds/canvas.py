@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from vc_gym.angles import wrap180, wrap360
-from vc_gym.worlds.paint import random_colour, smooth_noise, to_uint8
+from vc_gym.worlds.paint import random_color, smooth_noise, to_uint8
 
 __all__ = ["Canvas"]
 
@@ -364,16 +364,16 @@ class Canvas:
             self.rect(x0 + 0.04, x1 - 0.04, y0 + 0.04, y1 - 0.04, (246, 246, 246))
             self.rect(x0 + 0.1, x1 - 0.1, y0 - 0.05, y0, (150, 150, 155))  # pen tray
             for _ in range(int(rng.integers(3, 6))):
-                colour = rng.choice([(200, 30, 30), (30, 60, 180), (20, 120, 40), (30, 30, 30)])
+                color = rng.choice([(200, 30, 30), (30, 60, 180), (20, 120, 40), (30, 30, 30)])
                 bx = rng.uniform(x0 + 0.15, x1 - 0.5)
                 by = rng.uniform(y0 + 0.15, y1 - 0.35)
                 bw, bh = rng.uniform(0.25, 0.6), rng.uniform(0.15, 0.3)
                 if rng.uniform() < 0.5:
-                    self.outline(bx, bx + bw, by, by + bh, 0.03, colour)
+                    self.outline(bx, bx + bw, by, by + bh, 0.03, color)
                 else:
                     for k in range(int(rng.integers(1, 4))):  # "text" lines
                         yy = by + bh - k * 0.09
-                        self.rect(bx, bx + bw * rng.uniform(0.5, 1.0), yy - 0.03, yy, colour)
+                        self.rect(bx, bx + bw * rng.uniform(0.5, 1.0), yy - 0.03, yy, color)
         else:
             self.rect(x0, x1, y0, y1, (120, 85, 50))
             self.rect(x0 + 0.04, x1 - 0.04, y0 + 0.04, y1 - 0.04, (190, 145, 95))
@@ -383,5 +383,5 @@ class Canvas:
                     rng.uniform(x0 + 0.06, x1 - 0.06 - w),
                     rng.uniform(y0 + 0.06, y1 - 0.06 - h),
                 )
-                colour = random_colour(rng, s=(0.0, 0.6), v=(0.8, 1.0))
-                self.rect(bx, bx + w, by, by + h, colour)
+                color = random_color(rng, s=(0.0, 0.6), v=(0.8, 1.0))
+                self.rect(bx, bx + w, by, by + h, color)

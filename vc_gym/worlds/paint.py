@@ -4,7 +4,7 @@ The procedural panoramas (:mod:`vc_gym.worlds.panorama_painters`), the ray-cast 
 (:mod:`vc_gym.worlds.room`), the :class:`~vc_gym.worlds.canvas.Canvas` and the PyBullet
 scene textures (:mod:`vc_gym.sim.textures`) all paint with these:
 
-* :func:`hsv` and :func:`random_colour`: colours as ``(3,)`` ``float32`` RGB in 0..255;
+* :func:`hsv` and :func:`random_color`: colours as ``(3,)`` ``float32`` RGB in 0..255;
 * :func:`to_uint8`: a painted float image as the ``uint8`` image everything else takes;
 * :func:`value_noise`: smooth value noise in ``[-1, 1]``, periodic along x (seamless
   around a panorama or a room's perimeter);
@@ -22,11 +22,14 @@ All randomness comes from the ``numpy.random.Generator`` passed in.
 from __future__ import annotations
 
 import colorsys
+import sys
 
 import cv2
 import numpy as np
 
-__all__ = ["hsv", "random_colour", "smooth_noise", "smoothstep", "to_uint8", "value_noise"]
+from vc_gym.deprecation import moved_names
+
+__all__ = ["hsv", "random_color", "smooth_noise", "smoothstep", "to_uint8", "value_noise"]
 
 
 def hsv(h: float, s: float, v: float) -> np.ndarray:
@@ -48,7 +51,7 @@ def hsv(h: float, s: float, v: float) -> np.ndarray:
     return np.array([r, g, b], dtype=np.float32) * np.float32(255.0)
 
 
-def random_colour(
+def random_color(
     rng: np.random.Generator,
     s: tuple[float, float] = (0.5, 1.0),
     v: tuple[float, float] = (0.5, 1.0),
@@ -71,6 +74,10 @@ def random_colour(
         ``(3,)`` ``float32`` RGB in 0..255.
     """
     return hsv(rng.uniform(*h), rng.uniform(*s), rng.uniform(*v))
+
+
+# deprecated: random_colour, the British spelling of random_color, served for one release
+__getattr__ = moved_names(__name__, {"random_colour": (sys.modules[__name__], "random_color")})
 
 
 def to_uint8(img: np.ndarray) -> np.ndarray:

@@ -19,7 +19,7 @@ import numpy as np
 from vc_gym.angles import wrap180
 from vc_gym.validation import int_at_least, nonnegative_float
 from vc_gym.worlds.canvas import Canvas
-from vc_gym.worlds.paint import hsv, random_colour, value_noise
+from vc_gym.worlds.paint import hsv, random_color, value_noise
 from vc_gym.worlds.panorama import Panorama
 
 __all__ = ["PANORAMA_KINDS", "make_panorama"]
@@ -109,8 +109,8 @@ def _draw_room(rng: np.random.Generator, canvas: Canvas) -> None:
         outer = (np.abs(gx - rx) < hx) & (np.abs(gy - ry) < hy)
         inner = (np.abs(gx - rx) < hx - border) & (np.abs(gy - ry) < hy - border)
         floor = z[rows] < 0
-        img[rows][outer & floor] = random_colour(rng, **_VARIED)
-        img[rows][inner & floor] = random_colour(rng, **_VARIED)
+        img[rows][outer & floor] = random_color(rng, **_VARIED)
+        img[rows][inner & floor] = random_color(rng, **_VARIED)
 
     # --- things on the walls. Floor-standing items stay below 0.95 m, wall-mounted
     # ones above 1.0 m; doors and bookcases take both layers.
@@ -185,13 +185,13 @@ def _draw_room_item(
         if rng.uniform() < 0.5:
             leaf = hsv(rng.uniform(0.05, 0.11), rng.uniform(0.4, 0.75), rng.uniform(0.3, 0.65))
         else:
-            leaf = random_colour(rng, **_VARIED)
+            leaf = random_color(rng, **_VARIED)
         casing = hsv(rng.uniform(), rng.uniform(0.0, 0.15), rng.uniform(0.75, 0.95))
         canvas.paint(cols, band(0.0, top + 0.08), casing)
         canvas.paint(cols, band(0.0, top) & inside(0.12), leaf)
     elif kind == "bookcase":
         top = rng.uniform(1.3, 2.0)
-        frame = random_colour(rng, **_VARIED)
+        frame = random_color(rng, **_VARIED)
         canvas.paint(cols, band(0.0, top), frame)
         n_shelves = int(rng.integers(3, 6))
         board = rng.uniform(0.04, 0.07)
@@ -207,7 +207,7 @@ def _draw_room_item(
                 if rng.uniform() < 0.7:
                     book_top = lo_in + rng.uniform(0.55, 0.95) * (hi_in - lo_in)
                     m = band(lo_in, book_top) & (u[None, :] <= x) & (u[None, :] > x - w)
-                    canvas.paint(cols, m & inside(0.1), random_colour(rng, **_VARIED))
+                    canvas.paint(cols, m & inside(0.1), random_color(rng, **_VARIED))
                 x -= w
     elif kind == "window":
         z0, z1 = rng.uniform(1.0, 1.2), min(rng.uniform(2.0, 2.3), room_h - 0.15)
@@ -225,20 +225,20 @@ def _draw_room_item(
             block[pane_mask] = sky[pane_mask]
             canvas.img[:, cols] = block
         if rng.uniform() < 0.6:  # curtains on both sides
-            curtain = random_colour(rng, **_VARIED)
+            curtain = random_color(rng, **_VARIED)
             canvas.paint(cols, band(z0 - 0.25, z1 + 0.1) & ~inside(0.22, 1.0), curtain)
     elif kind == "cabinet":
         top = rng.uniform(0.45, 0.95)
-        body = random_colour(rng, **_VARIED)
+        body = random_color(rng, **_VARIED)
         slab = (
-            body * rng.uniform(0.55, 0.8) if rng.uniform() < 0.5 else random_colour(rng, **_VARIED)
+            body * rng.uniform(0.55, 0.8) if rng.uniform() < 0.5 else random_color(rng, **_VARIED)
         )
         canvas.paint(cols, band(0.0, top), body)
         canvas.paint(cols, band(top - rng.uniform(0.04, 0.08), top), slab)
         canvas.paint(cols, band(0.0, 0.07), body * 0.4)  # plinth shadow
     elif kind == "table":
         top = rng.uniform(0.6, 0.8)
-        wood = random_colour(rng, **_VARIED)
+        wood = random_color(rng, **_VARIED)
         thick = rng.uniform(0.05, 0.09)
         shadow = wall_cols[None, :, :] * np.float32(rng.uniform(0.45, 0.65))
         under = band(0.0, top - thick)
@@ -251,15 +251,15 @@ def _draw_room_item(
     else:  # poster / painting
         z0 = rng.uniform(1.05, 1.5)
         z1 = min(z0 + max(rng.uniform(0.5, 1.2) * width_m, 0.25), room_h - 0.2)
-        outer = random_colour(rng, **_VARIED)
+        outer = random_color(rng, **_VARIED)
         canvas.paint(cols, band(z0, z1), outer)
         inset = rng.uniform(0.08, 0.2)
         dz = inset * (z1 - z0)
         inner = band(z0 + dz, z1 - dz) & inside(inset)
-        canvas.paint(cols, inner, random_colour(rng, **_VARIED))
+        canvas.paint(cols, inner, random_color(rng, **_VARIED))
         if rng.uniform() < 0.5:  # two-tone picture (a "landscape")
             split = z0 + dz + rng.uniform(0.3, 0.6) * (z1 - z0 - 2 * dz)
-            canvas.paint(cols, inner & (zb < split), random_colour(rng, **_VARIED))
+            canvas.paint(cols, inner & (zb < split), random_color(rng, **_VARIED))
 
 
 def _draw_outdoor(rng: np.random.Generator, canvas: Canvas) -> None:
@@ -320,7 +320,7 @@ def _draw_outdoor(rng: np.random.Generator, canvas: Canvas) -> None:
         canvas.paint(cols, (e >= base) & (e < top) & (u >= 0), body)
         canvas.paint(cols, (e >= base) & (e < top) & (u < 0), body * rng.uniform(0.6, 0.8))
         roof_h = rng.uniform(0.1, 0.2) * (top - base)
-        canvas.paint(cols, (e >= top - roof_h) & (e < top), random_colour(rng, **_VARIED) * 0.6)
+        canvas.paint(cols, (e >= top - roof_h) & (e < top), random_color(rng, **_VARIED) * 0.6)
         if top - base > 9.0 and hw > 6.0 and rng.uniform() < 0.7:
             glass = hsv(rng.uniform(0.5, 0.65), rng.uniform(0.2, 0.5), rng.uniform(0.2, 0.45))
             cell_e, cell_a = rng.uniform(3.5, 5.0), rng.uniform(4.5, 7.0)
@@ -361,10 +361,10 @@ def _draw_outdoor(rng: np.random.Generator, canvas: Canvas) -> None:
         ce, he = rng.uniform(-30.0, -4.0), rng.uniform(2.0, 7.0)
         m = ((rel[None, :] / hw) ** 2 + ((el[:, None] - ce) / he) ** 2 <= 1.0) & (el[:, None] >= ce)
         if rng.uniform() < 0.5:
-            colour = hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.8), rng.uniform(0.2, 0.45))
+            color = hsv(rng.uniform(0.2, 0.4), rng.uniform(0.4, 0.8), rng.uniform(0.2, 0.45))
         else:
-            colour = random_colour(rng, **_VARIED)
-        canvas.paint(cols, m, colour)
+            color = random_color(rng, **_VARIED)
+        canvas.paint(cols, m, color)
 
 
 def make_panorama(

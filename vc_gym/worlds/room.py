@@ -57,7 +57,7 @@ from vc_gym.compass.camera import Camera
 from vc_gym.exposure import gain_table
 from vc_gym.images import check_image
 from vc_gym.validation import finite_float, int_at_least, positive_float
-from vc_gym.worlds.paint import hsv, random_colour, value_noise
+from vc_gym.worlds.paint import hsv, random_color, value_noise
 from vc_gym.worlds.rays import REMAP_MAX_SIDE, ray_grid
 
 __all__ = ["Room", "make_room", "render_room_view"]
@@ -186,18 +186,18 @@ class _Texture:
         r0, r1 = np.searchsorted(self._neg_z, [-z1, -z0], side="right")
         return slice(int(r0), int(r1)), slice(int(c0), int(c1))
 
-    def rect(self, s0: float, s1: float, z0: float, z1: float, colour: np.ndarray) -> None:
-        self.img[self.region(s0, s1, z0, z1)] = colour
+    def rect(self, s0: float, s1: float, z0: float, z1: float, color: np.ndarray) -> None:
+        self.img[self.region(s0, s1, z0, z1)] = color
 
     def scale(self, s0: float, s1: float, z0: float, z1: float, factor: float) -> None:
         self.img[self.region(s0, s1, z0, z1)] *= np.float32(factor)
 
-    def disc(self, sc: float, zc: float, radius: float, colour: np.ndarray) -> None:
+    def disc(self, sc: float, zc: float, radius: float, color: np.ndarray) -> None:
         rows, cols = self.region(sc - radius, sc + radius, zc - radius, zc + radius)
         s = self._s[cols][None, :]
         z = -self._neg_z[rows][:, None]
         block = self.img[rows, cols]
-        block[(s - sc) ** 2 + (z - zc) ** 2 <= radius * radius] = colour
+        block[(s - sc) ** 2 + (z - zc) ** 2 <= radius * radius] = color
         self.img[rows, cols] = block
 
 
@@ -237,10 +237,10 @@ class _Layout:
 
 def _vivid(rng: np.random.Generator) -> np.ndarray:
     """A saturated poster colour."""
-    return random_colour(rng, s=(0.45, 0.95), v=(0.45, 0.95))
+    return random_color(rng, s=(0.45, 0.95), v=(0.45, 0.95))
 
 
-def _furniture_colour(rng: np.random.Generator) -> np.ndarray:
+def _furniture_color(rng: np.random.Generator) -> np.ndarray:
     """Grey, beige, wood or (sometimes) a colourful lacquer."""
     kind = rng.uniform()
     if kind < 0.35:  # grey / white laminate
@@ -329,7 +329,7 @@ def _paint_cabinet(
     rng: np.random.Generator, tex: _Texture, s0: float, s1: float, max_top: float
 ) -> None:
     top = min(rng.uniform(0.7, max_top), tex.wall_height - 0.15)
-    body = _furniture_colour(rng)
+    body = _furniture_color(rng)
     tex.rect(s0, s1, 0.0, top, body)
     # drawers or doors: alternating shades in coarse horizontal bands
     n = max(1, int(round(top / rng.uniform(0.35, 0.6))))
@@ -350,7 +350,7 @@ def _paint_desk(
 ) -> None:
     top = rng.uniform(0.72, 0.78)
     slab = rng.uniform(0.05, 0.07)
-    wood = _furniture_colour(rng)
+    wood = _furniture_color(rng)
     tex.rect(s0, s1, 0.0, top - slab, wall_rgb * np.float32(rng.uniform(0.4, 0.55)))  # shadow
     tex.rect(s0, s1, top - slab, top, wood)
     panel = 0.1

@@ -56,7 +56,8 @@ def test_the_heap_figure_counts_what_c_code_allocates_and_frees():
     try:
         ctypes.memset(block, 1, size)
         release_free_memory()  # never releases memory still in use
-        assert heap_in_use_bytes() - heap0 >= size
+        # the heap is the process': other threads of a test worker may free a little
+        assert heap_in_use_bytes() - heap0 >= 0.9 * size
         assert rss_bytes() - rss0 >= 0.9 * size
     finally:
         _GLIBC.free(block)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.experiments.views.frames import check_frames, learning_turn, look
+from vc_gym.experiments.views.frames import check_frames, frames_at_pose, learning_turn
 from vc_gym.sim import AiboRoomEnv
 
 #: The training spot of the ``learned`` fixture (robolab's rear half centre, 5.1).
@@ -15,12 +15,12 @@ SPOT = (-1.5, 0.0)
 
 def test_look_is_history_independent(room):
     pose = (0.4, -0.7, 123.0)
-    first = look(room, pose, frames=4, seed=11)
-    look(room, (2.0, 1.0, 10.0), frames=3, seed=2)  # something else in between
-    again = look(room, pose, frames=4, seed=11)
+    first = frames_at_pose(room, pose, frames=4, seed=11)
+    frames_at_pose(room, (2.0, 1.0, 10.0), frames=3, seed=2)  # something else in between
+    again = frames_at_pose(room, pose, frames=4, seed=11)
     fresh_env = AiboRoomEnv()
     try:
-        fresh = look(fresh_env, pose, frames=4, seed=11)
+        fresh = frames_at_pose(fresh_env, pose, frames=4, seed=11)
     finally:
         fresh_env.close()
     for other in (again, fresh):
@@ -39,7 +39,7 @@ def test_look_is_history_independent(room):
 
 def test_bad_looks(room):
     with pytest.raises(ValueError, match="AiboRoomEnv"):
-        look(object(), (0.0, 0.0, 0.0), 2, seed=0)
+        frames_at_pose(object(), (0.0, 0.0, 0.0), 2, seed=0)
     for kwargs, match in [
         ({"pose": (0.0, float("nan"), 0.0)}, "pose"),
         ({"pose": (0.0, 0.0)}, "pose"),
@@ -51,14 +51,14 @@ def test_bad_looks(room):
     ]:
         args = {"pose": (0.0, 0.0, 0.0), "frames": 2, "seed": 0, **kwargs}
         with pytest.raises(ValueError, match=match):
-            look(room, **args)
+            frames_at_pose(room, **args)
 
 
 def test_a_learning_turn_faces_eight_directions_with_the_measured_pans(room):
     turn = learning_turn(room, SPOT, frames_per_direction=2, seed=5)
     assert len(turn) == 8 * 2
     for k in range(8):
-        pans = [f[1] for f in look(room, (*SPOT, 45.0 * k), 2, seed=5 + k)]
+        pans = [f[1] for f in frames_at_pose(room, (*SPOT, 45.0 * k), 2, seed=5 + k)]
         for (image, camera), pan in zip(turn[2 * k : 2 * k + 2], pans, strict=True):
             assert image.shape == (160, 208, 3)
             assert camera.yaw_deg == pytest.approx(45.0 * k + pan)
@@ -76,3 +76,13 @@ def test_check_frames_refuses_malformed_frames():
     ]:
         with pytest.raises(ValueError, match=match):
             check_frames(frames)
+
+
+@pytest.mark.parametrize("module", ["vc_gym.experiments.views", "vc_gym.experiments.views.frames"])
+def test_the_old_name_look_warns_and_is_frames_at_pose(module):
+    import importlib
+
+    from vc_gym.experiments.views.frames import frames_at_pose
+
+    with pytest.warns(DeprecationWarning, match="frames_at_pose"):
+        assert importlib.import_module(module).look is frames_at_pose

@@ -16,7 +16,7 @@ def test_canonical_choices_draw_nothing():
     assert d.integers(3, 0, 9) == 3
     assert d.choice("a", ["b", "c"]) == "a"
     assert d.chance(True, 0.0) is True
-    np.testing.assert_array_equal(d.colour((10, 20, 30)), np.float32([10, 20, 30]))
+    np.testing.assert_array_equal(d.color((10, 20, 30)), np.float32([10, 20, 30]))
     assert rng.uniform() == np.random.default_rng(0).uniform()  # the generator is untouched
 
 
@@ -36,3 +36,13 @@ def test_on_is_a_deprecated_alias_of_randomize():
     with pytest.warns(DeprecationWarning, match="Draw.randomize"):
         d.on = False
     assert d.randomize is False
+
+
+@pytest.mark.parametrize("randomize", [False, True])
+def test_colour_is_a_deprecated_alias_of_color(randomize):
+    new = Draw(np.random.default_rng(3), randomize=randomize)
+    old = Draw(np.random.default_rng(3), randomize=randomize)
+    with pytest.warns(DeprecationWarning, match="Draw.color"):
+        rgb = old.colour((10, 20, 30), dh=0.5)
+    np.testing.assert_array_equal(rgb, new.color((10, 20, 30), dh=0.5))
+    assert old.rng.uniform() == new.rng.uniform()  # the same draws

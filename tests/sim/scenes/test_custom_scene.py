@@ -39,7 +39,7 @@ def box_room(b: Builder) -> SceneLayout:
 
     Large enough for LearnThenHome's learning spots 1 m around home (the origin).
     """
-    room = Room(b, BOUNDS, 2.4, {s: b.choices.colour(rgb, dh=0.02) for s, rgb in WALL_RGB.items()})
+    room = Room(b, BOUNDS, 2.4, {s: b.choices.color(rgb, dh=0.02) for s, rgb in WALL_RGB.items()})
     poster = textures.procedural_poster(b.rng, (96, 64), "blocks")
     north = room.walls["N"]  # u from the west end (x = -2.5) eastwards
     north.canvas.framed(3.7, 4.3, 0.5, 1.4, poster, (25, 25, 25), 0.04)

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from vc_gym.experiments.options import OPTIONS, Option
+from vc_gym.experiments.options import HOMING_MODE_HELP, OPTIONS, Option
 from vc_gym.experiments.studies.common import SIZES, ExperimentOptions
 
 __all__ = ["EXPERIMENTS", "SIZES", "Experiment", "ExperimentOptions", "get_experiment"]
@@ -102,7 +102,16 @@ EXPERIMENTS: dict[str, Experiment] = {
             "learned agents against the scripted one: the homing experiment for every "
             "--agent scripted,DIR/model.zip,... on the same learning seeds and kidnappings; "
             "each agent's figures, the learned agents' mean ± std and a paired comparison",
-            _options(*_HOMING, "agents", "allow_imports", "atlas_dir", "video"),
+            _options(
+                *[n for n in _HOMING if n != "mode"],
+                "agents",
+                "allow_imports",
+                "atlas_dir",
+                "video",
+                mode="the places every agent homes in are learned this way, and the scripted "
+                "agent homes so (default: paper, the way the learned agents' training places "
+                "were learned): " + HOMING_MODE_HELP,
+            ),
         ),
         Experiment(
             "orientation",

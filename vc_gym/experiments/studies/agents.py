@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.experiments.episode import DEFAULT_HOMING_MODE
+from vc_gym.experiments.episode import LEARNED_AGENT_MODE, canonical_homing_mode
 from vc_gym.experiments.studies import get_experiment
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.kidnapping import PAPER_MEAN_CM, PAPER_STD_CM, mean_std
@@ -66,7 +66,7 @@ def run_agents(
     episodes: int | None = None,
     learn_time_s: float | None = None,
     max_homing_s: float | None = None,
-    mode: str = DEFAULT_HOMING_MODE,
+    mode: str | None = None,
     allow_imports: bool = False,
 ) -> dict[str, Any]:
     """Run the homing experiment for every agent on the same kidnappings.
@@ -82,9 +82,11 @@ def run_agents(
         ``"scripted"`` and learned agents (``"pretrained"`` or ``DIR/model.zip``),
         comma-separated or a list. A learned agent's label is its folder's name.
     tracker, seeds, episodes, learn_time_s, max_homing_s, mode, allow_imports
-        As :func:`~vc_gym.experiments.studies.homing.run_homing` (the learned agents
-        run with the ``mode``'s learning; only the scripted agent has a homing policy
-        mode).
+        As :func:`~vc_gym.experiments.studies.homing.run_homing`. Every agent homes in
+        the same places, learned the ``mode``'s way (default
+        :data:`~vc_gym.experiments.episode.LEARNED_AGENT_MODE`, the way the learned
+        agents' training places were learned); only the scripted agent has a homing
+        policy mode.
 
     Returns
     -------
@@ -92,6 +94,7 @@ def run_agents(
         The results written to ``results.json``.
     """
     opts = opts or ExperimentOptions()
+    mode = canonical_homing_mode(LEARNED_AGENT_MODE if mode is None else mode)
     agents = agent_list(agent)
     labels = _labels(agents)
     out = check_out_dir(out_dir)

@@ -27,10 +27,10 @@ from vc_gym.envs.homing import home_offset
 from vc_gym.envs.learning import HOME
 from vc_gym.experiments.atlases import atlas_key, atlas_spec, ensure_atlases
 from vc_gym.experiments.episode import (
-    DEFAULT_HOMING_MODE,
     HOMING_MODES,
     canonical_homing_mode,
     check_agent_env,
+    default_homing_mode,
 )
 from vc_gym.experiments.spot_sensors import spot_sensor_job
 from vc_gym.experiments.studies import kidnapping
@@ -42,7 +42,7 @@ from vc_gym.experiments.studies.common import (
     scene_field_bounds,
 )
 from vc_gym.experiments.studies.kidnapping import EPISODE_JOB
-from vc_gym.experiments.views import field_grid, look, plot_goodness_field, spot_goodness
+from vc_gym.experiments.views import field_grid, frames_at_pose, plot_goodness_field, spot_goodness
 from vc_gym.heading_sensors import IMAGE_SENSORS, SENSOR_GRID, current_sensor_name
 from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
@@ -115,7 +115,7 @@ def field_job(
     camera = Camera(hfov_deg=room.camera.hfov_deg)
     per_heading = []
     for k, h in enumerate(headings):
-        seen = look(room, (x, y, h), frames, seed=seed + k)
+        seen = frames_at_pose(room, (x, y, h), frames, seed=seed + k)
         per_heading.append(spot_goodness(seen, loaded, camera))
     return {
         "position": [x, y],
@@ -136,7 +136,7 @@ def run_homing(
     success_radius_m: float = 0.3,
     relearn: str = "scene",
     field: bool = True,
-    mode: str = DEFAULT_HOMING_MODE,
+    mode: str | None = None,
     sensor: str | None = None,
     home_offset_m: Sequence[float] | None = None,
     allow_imports: bool = False,
@@ -169,9 +169,11 @@ def run_homing(
         anew in every episode (slow).
     field : bool
         Also measure the likelihood field of fig. 5 (right).
-    mode : str
-        ``"check-home"`` (default) or ``"paper"`` (:data:`MODES`: how the place is learned and how
-        the scripted agent homes).
+    mode : str, optional
+        ``"check-home"`` or ``"paper"`` (:data:`MODES`: how the place is learned and how
+        the scripted agent homes). Default
+        :func:`~vc_gym.experiments.episode.default_homing_mode`: check-home for the
+        scripted agent, paper for a learned one.
     sensor : str, optional
         An image sensor of :data:`vc_gym.heading_sensors.IMAGE_SENSORS` (``"feature"``,
         ``"image_difference"``, ...) as the grid tracker's heading sensor: for every
@@ -211,7 +213,7 @@ def run_homing(
         positive_float(name, v)
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
-    mode = canonical_homing_mode(mode)
+    mode = canonical_homing_mode(default_homing_mode(agent) if mode is None else mode)
     tracker = check_tracker_spec(tracker)
     if sensor is not None:
         sensor = current_sensor_name(sensor)  # a deprecated name warns and is replaced

@@ -62,7 +62,7 @@ from vc_gym.experiments.studies.common import (
     pick_size,
     scene_field_bounds,
 )
-from vc_gym.experiments.views import field_grid, look, view_poses
+from vc_gym.experiments.views import field_grid, frames_at_pose, view_poses
 from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
 from vc_gym.jobs.workers import worker_cache
@@ -160,14 +160,16 @@ def learn_grid_job(
     pts = np.asarray(spots, np.float64)
     x0, x1, y0, y1 = room.scene.field_bounds
     centre = int(np.argmin(np.hypot(pts[:, 0] - (x0 + x1) / 2, pts[:, 1] - (y0 + y1) / 2)))
-    fit = [look(room, (*pts[centre], 45.0 * k), 1, seed=seed)[0][0] for k in range(8)]
+    fit = [frames_at_pose(room, (*pts[centre], 45.0 * k), 1, seed=seed)[0][0] for k in range(8)]
     config = CompassConfig()
     colors = VisualCompass(config).fit_colors(fit).colors
     maps = {}
     for i, (x, y) in enumerate(pts):
         vc = VisualCompass(config, colors)
         for k in range(8):
-            for image, pan, _ in look(room, (x, y, 45.0 * k), steps, seed=seed + 100 * i + k):
+            for image, pan, _ in frames_at_pose(
+                room, (x, y, 45.0 * k), steps, seed=seed + 100 * i + k
+            ):
                 vc.learn(image, camera.replace(yaw_deg=45.0 * k + pan))
         maps[f"spot{i}"] = ((float(x), float(y)), vc)
     atlas = CompassAtlas(maps, home=f"spot{centre}")
@@ -176,7 +178,7 @@ def learn_grid_job(
     places = vc_gym.localization.calibration_points(pts, room.scene.field_bounds)
     for i, (x, y) in enumerate(places):
         for h in rng.uniform(0.0, 360.0, calibration_headings):
-            for image, _, _ in look(room, (x, y, float(h)), 2, seed=seed + 50_000 + i):
+            for image, _, _ in frames_at_pose(room, (x, y, float(h)), 2, seed=seed + 50_000 + i):
                 raw, _ = atlas.scores(image, camera)
                 positions.append([float(x), float(y)])
                 scores.append([round(float(v), 6) for v in raw])
@@ -219,7 +221,7 @@ def turn_scores(
     images = [
         image
         for k in range(headings)
-        for image, _, _ in look(
+        for image, _, _ in frames_at_pose(
             room,
             (float(position[0]), float(position[1]), start_deg + k * 360.0 / headings),
             frames,
@@ -246,7 +248,7 @@ def locate_job(
     camera = Camera(hfov_deg=room.camera.hfov_deg)
     out = []
     for k, pose in enumerate(poses):
-        images = [image for image, _, _ in look(room, tuple(pose), frames, seed=seed + k)]
+        images = [image for image, _, _ in frames_at_pose(room, tuple(pose), frames, seed=seed + k)]
         view = {"pose": pose, "scores": mean_spot_scores(loaded, images, camera).round(6).tolist()}
         if turn_headings:
             turn = turn_scores(

@@ -40,7 +40,7 @@ from vc_gym.experiments.views import (
     distance_table,
     evaluate_view,
     field_grid,
-    look,
+    frames_at_pose,
     spots_array,
     view_poses,
 )
@@ -183,7 +183,7 @@ def view_job(
     spots = spots_array(spot)
     views, costs = [], {}
     for k, pose in enumerate(poses):
-        seen = look(env, tuple(pose), frames, seed=seed + k)
+        seen = frames_at_pose(env, tuple(pose), frames, seed=seed + k)
         figures, timing = evaluate_view(seen, loaded, camera, env.control_dt, pose[2], trackers)
         views.append(
             {

@@ -31,7 +31,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 from vc_gym.angles import wrap180
 from vc_gym.experiments.real_data import ROTATION_SETS, default_real_data_dir, load_rotation_set
 from vc_gym.experiments.real_rotation import rotation_set_errors
-from vc_gym.experiments.spot_sensors import fit_colours, room, teach
+from vc_gym.experiments.spot_sensors import fit_colors, room, teach
 from vc_gym.experiments.studies import get_experiment
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
@@ -42,7 +42,7 @@ from vc_gym.experiments.studies.common import (
     scene_field_bounds,
 )
 from vc_gym.experiments.studies.orientation_grid import rear_half_centre
-from vc_gym.experiments.views import learning_turn, look
+from vc_gym.experiments.views import frames_at_pose, learning_turn
 from vc_gym.heading_sensors import NoisyMagneticCompass, make_sensor
 from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
@@ -64,7 +64,7 @@ SENSORS: dict[str, Any] = {
     "visual_compass": "visual_compass",
     "visual_compass_mean_exposure": {"type": "visual_compass", "exposure": "mean"},
     "image_difference": "image_difference",
-    "sector_colour": "sector_colour",
+    "sector_color": "sector_color",
     "feature": "feature",
     "magnetic": "magnetic",
 }
@@ -84,7 +84,7 @@ HOMING_SENSORS = (
     "atlas",
     "visual_compass",
     "image_difference",
-    "sector_colour",
+    "sector_color",
     "feature",
     "magnetic",
 )
@@ -163,7 +163,7 @@ def sensors_scene_job(
             built[name] = _magnetometer(scene, bounds, seed)
             continue
         sensor = make_sensor(spec)
-        fit_colours(sensor, learning)  # once per place: not part of the per-frame cost
+        fit_colors(sensor, learning)  # once per place: not part of the per-frame cost
         t0 = time.perf_counter()
         teach(sensor, learning)
         timing[f"{name}/learn"] = 1e3 * (time.perf_counter() - t0) / len(learning)
@@ -171,7 +171,9 @@ def sensors_scene_job(
     out, cost = [], {name: [] for name in built}
     for i, view in enumerate(views):
         pose = view["pose"]
-        (image, pan, _), *_ = look(rooms[view["light"]], tuple(pose), 1, seed=seed + 100 + i)
+        (image, pan, _), *_ = frames_at_pose(
+            rooms[view["light"]], tuple(pose), 1, seed=seed + 100 + i
+        )
         truth = pose[2] + pan
         errors, spreads = {}, {}
         for name, sensor in built.items():
@@ -197,7 +199,7 @@ def sensors_real_job(folder: str, sensors: dict[str, Any]) -> dict[str, Any]:
     for name, spec in sensors.items():
         if _is_magnetic(spec):
             continue
-        r = rotation_set_errors(photos, make_sensor(spec), prepare=teach, setup=fit_colours)
+        r = rotation_set_errors(photos, make_sensor(spec), prepare=teach, setup=fit_colors)
         e = np.asarray(r["errors_deg"])
         out[name] = _error_stats(e)
         timing[f"{name}/learn"] = r["learn_ms"]

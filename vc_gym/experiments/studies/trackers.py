@@ -124,7 +124,7 @@ def run_trackers(
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     mode = canonical_homing_mode(mode)
     settings = {"trackers": named, "scenes": scenes, "seeds": seeds, "episodes": episodes}
-    if mode != "paper":  # a paper-mode run's settings (and so its jobs) stay as they were
+    if mode != "paper":  # a paper-mode run's settings (and so its jobs) have no mode key
         settings["mode"] = mode
     run = open_run(out_dir, "trackers", opts, settings)
 

@@ -12,7 +12,7 @@ depends on its arguments, seeds included, never on what the same process compute
 before), one concept a module:
 
 * :mod:`~.poses` -- :func:`field_grid` and :func:`view_poses`: where the robot is put;
-* :mod:`~.frames` -- :func:`look`: reset an :class:`~vc_gym.sim.aibo_room.AiboRoomEnv`
+* :mod:`~.frames` -- :func:`frames_at_pose`: reset an :class:`~vc_gym.sim.aibo_room.AiboRoomEnv`
   at a pose and let the robot stand there, scanning with its head, for some frames;
   :func:`learning_turn`: a full turn's frames with their true camera yaws;
 * :mod:`~.evaluation` -- :func:`evaluate_view`: feed the frames to every tracker and
@@ -29,11 +29,13 @@ Typical use (one spot learned with :class:`~vc_gym.envs.learning.SpotLearning`):
     room.reset(seed=0)
     atlas = SpotLearning((-1.5, 0.0))(room, LearningConfig()).atlas
     for i, pose in enumerate(view_poses(field_grid(bounds, 0.33), 1, rng)):
-        frames = look(room, pose, frames=15, seed=i)
+        frames = frames_at_pose(room, pose, frames=15, seed=i)
         figures, timing = evaluate_view(frames, atlas, camera, room.control_dt,
                                         pose[2], {"grid": "grid"})
 """
 
+from vc_gym.deprecation import moved_names
+from vc_gym.experiments.views import frames
 from vc_gym.experiments.views.arrow_field import plot_arrow_field
 from vc_gym.experiments.views.checks import spots_array
 from vc_gym.experiments.views.error_vs_distance import (
@@ -43,7 +45,7 @@ from vc_gym.experiments.views.error_vs_distance import (
     plot_error_vs_distance,
 )
 from vc_gym.experiments.views.evaluation import COMPASS, evaluate_view, spot_goodness
-from vc_gym.experiments.views.frames import Frame, learning_turn, look
+from vc_gym.experiments.views.frames import Frame, frames_at_pose, learning_turn
 from vc_gym.experiments.views.goodness_field import plot_goodness_field
 from vc_gym.experiments.views.poses import field_grid, view_poses
 
@@ -56,7 +58,7 @@ __all__ = [
     "evaluate_view",
     "field_grid",
     "learning_turn",
-    "look",
+    "frames_at_pose",
     "plot_arrow_field",
     "plot_error_vs_distance",
     "plot_goodness_field",
@@ -64,3 +66,5 @@ __all__ = [
     "spots_array",
     "view_poses",
 ]
+
+__getattr__ = moved_names(__name__, {"look": (frames, "frames_at_pose")})

@@ -42,7 +42,7 @@ def evaluate_view(
     Parameters
     ----------
     frames : sequence of tuple
-        ``(image, head_pan_deg, odometry)`` per frame, e.g. from :func:`look`.
+        ``(image, head_pan_deg, odometry)`` per frame, e.g. from :func:`frames_at_pose`.
     atlas : CompassAtlas
         The learned, normalised atlas.
     camera : Camera
@@ -129,7 +129,7 @@ def spot_goodness(frames: Sequence[Frame], atlas: CompassAtlas, camera: Camera) 
     Parameters
     ----------
     frames : sequence of tuple
-        ``(image, head_pan_deg, odometry)`` per frame, e.g. from :func:`look`.
+        ``(image, head_pan_deg, odometry)`` per frame, e.g. from :func:`frames_at_pose`.
     atlas : CompassAtlas
         The learned atlas (normalised, or the goodness is ``exp(score)``).
     camera : Camera

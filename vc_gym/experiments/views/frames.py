@@ -1,23 +1,25 @@
-"""Frames from the robot standing at a pose: :func:`look` (scanning with its head, paper
+"""Frames from the robot standing at a pose: :func:`frames_at_pose` (scanning with its head, paper
 5.1) and :func:`learning_turn` (a full turn with the true camera yaws, paper 4.3)."""
 
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Sequence
 
 import numpy as np
 
 from vc_gym.compass import Camera
+from vc_gym.deprecation import moved_names
 from vc_gym.envs.learning import HEAD_SCAN_DEG, RobotFell
 from vc_gym.experiments.views.checks import int_at_least
 from vc_gym.poses import check_pose
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.validation import finite_float
 
-__all__ = ["Frame", "check_frames", "learning_turn", "look"]
+__all__ = ["Frame", "check_frames", "frames_at_pose", "learning_turn"]
 
-#: One frame of :func:`look`: ``(image, measured head pan in degrees, odometry
+#: One frame of :func:`frames_at_pose`: ``(image, measured head pan in degrees, odometry
 #: (forward m, left m, turn deg) since the previous frame)``.
 Frame = tuple[np.ndarray, float, tuple[float, float, float]]
 
@@ -39,7 +41,7 @@ def check_frames(frames: object) -> list[Frame]:
     return out
 
 
-def look(
+def frames_at_pose(
     room: AiboRoomEnv,
     pose: tuple[float, float, float] | np.ndarray,
     frames: int,
@@ -119,7 +121,7 @@ def learning_turn(
     """The frames of a learning turn at ``spot`` with their true camera yaws.
 
     The robot stands facing 0°, 45°, ..., 315° in turn (paper 4.3), scanning with its
-    head for ``frames_per_direction`` frames each (:func:`look`, seeds ``seed + k``);
+    head for ``frames_per_direction`` frames each (:func:`frames_at_pose`, seeds ``seed + k``);
     every frame comes with the camera that took it (its yaw the body's plus the
     measured pan). The truth, not odometry: every sensor taught with it gets the
     same, exact headings.
@@ -128,6 +130,10 @@ def learning_turn(
     camera = Camera(hfov_deg=env.camera.hfov_deg)
     out = []
     for k in range(8):
-        for image, pan, _ in look(room, (*spot, 45.0 * k), frames_per_direction, seed=seed + k):
+        for image, pan, _ in frames_at_pose(
+            room, (*spot, 45.0 * k), frames_per_direction, seed=seed + k
+        ):
             out.append((image, camera.replace(yaw_deg=45.0 * k + pan)))
     return out
+
+__getattr__ = moved_names(__name__, {"look": (sys.modules[__name__], "frames_at_pose")})

@@ -57,8 +57,8 @@ four coloured walls and a poster::
     def my_room(b):
         bounds, field = (-2.5, 2.5, -2.0, 2.0), (-1.5, 1.5, -1.2, 1.2)  # xmin, xmax, ymin, ymax
         paint = {"E": (200, 40, 40), "N": (40, 160, 60), "W": (40, 70, 200), "S": (230, 200, 40)}
-        # b.choices.colour gives the paint itself, or a nearby colour when randomize=True
-        room = Room(b, bounds, 2.5, {side: b.choices.colour(rgb) for side, rgb in paint.items()})
+        # b.choices.color gives the paint itself, or a nearby colour when randomize=True
+        room = Room(b, bounds, 2.5, {side: b.choices.color(rgb) for side, rgb in paint.items()})
         poster = textures.procedural_poster(b.rng, (120, 90), "blocks")
         north = room.walls["N"]  # u runs left to right seen from inside, z up
         north.canvas.framed(1.5, 2.4, 0.5, 1.7, poster, (25, 25, 25), 0.04)

@@ -22,6 +22,7 @@ __all__ = ["Draw"]
 
 _T = TypeVar("_T")
 _ON_DEPRECATED = "Draw.on is deprecated; use Draw.randomize"
+_COLOUR_DEPRECATED = "Draw.colour is deprecated; use Draw.color"
 
 
 class Draw:
@@ -129,7 +130,7 @@ class Draw:
         """
         return bool(self.rng.uniform() < p) if self.randomize else bool(canonical)
 
-    def colour(
+    def color(
         self, canonical: RGB, dh: float = 0.04, ds: float = 0.15, dv: float = 0.12
     ) -> np.ndarray:
         """``canonical`` (0..255) or a colour near it in hue, saturation and value.
@@ -156,3 +157,10 @@ class Draw:
             s + self.rng.uniform(-ds, ds),
             v + self.rng.uniform(-dv, dv),
         )
+
+    def colour(
+        self, canonical: RGB, dh: float = 0.04, ds: float = 0.15, dv: float = 0.12
+    ) -> np.ndarray:
+        """Deprecated name of :meth:`color` (the British spelling)."""
+        warnings.warn(_COLOUR_DEPRECATED, DeprecationWarning, stacklevel=2)
+        return self.color(canonical, dh, ds, dv)

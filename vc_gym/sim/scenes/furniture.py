@@ -13,9 +13,11 @@ layout choices (``b.choices``).
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
+from vc_gym.deprecation import moved_names
 from vc_gym.sim import textures as tx
 from vc_gym.sim.scenes.builder import Builder
 from vc_gym.sim.scenes.parts import RGB, Part
@@ -33,7 +35,7 @@ __all__ = [
     "shelf",
     "sofa",
     "sun",
-    "wall_colours",
+    "wall_colors",
     "window",
     "workstation",
 ]
@@ -42,7 +44,7 @@ __all__ = [
 # ---------------------------------------------------------------- painted decorations
 
 
-def _frame_colour(rng: np.random.Generator) -> tuple[np.ndarray, float]:
+def _frame_color(rng: np.random.Generator) -> tuple[np.ndarray, float]:
     kind = rng.uniform()
     if kind < 0.3:
         return np.array([25, 25, 25], np.float32), 0.035
@@ -52,7 +54,7 @@ def _frame_colour(rng: np.random.Generator) -> tuple[np.ndarray, float]:
         return np.array([235, 235, 232], np.float32), 0.04
     if kind < 0.85:
         return np.array([175, 178, 182], np.float32), 0.025
-    return tx.random_colour(rng), 0.04
+    return tx.random_color(rng), 0.04
 
 
 def hang_pictures(
@@ -101,7 +103,7 @@ def hang_pictures(
         else:
             img = tx.poster_image(rng, float(rng.uniform(0.65, 1.5)))
         aspect = img.shape[1] / img.shape[0]
-        frame_rgb, frame_m = _frame_colour(rng)
+        frame_rgb, frame_m = _frame_color(rng)
         for attempt in range(40):
             # shrink the picture a little after each failed attempt to fill small gaps
             w = float(rng.uniform(*width)) * (1.0 - attempt / 60.0)
@@ -137,8 +139,8 @@ def door(b: Builder, wall: Wall, u0: float, width: float = 0.9) -> None:
         Width of the door (m).
     """
     v = b.choices
-    leaf = v.colour((150, 105, 65), dh=0.5, ds=0.4, dv=0.3)
-    casing = v.colour((238, 236, 230), dh=0.1, ds=0.05, dv=0.08)
+    leaf = v.color((150, 105, 65), dh=0.5, ds=0.4, dv=0.3)
+    casing = v.color((238, 236, 230), dh=0.1, ds=0.05, dv=0.08)
     wall.canvas.door(u0, u0 + width, 2.05, leaf, casing)
     wall.take(u0 - 0.1, u0 + width + 0.1, 0.0, 2.15)
 
@@ -208,7 +210,7 @@ def ceiling_texture(b: Builder, bounds, panels: bool = True) -> np.ndarray:
     """
     x0, x1, y0, y1 = bounds
     # the ceiling's texture u runs along y, v along x (see Room.build)
-    c = tx.Canvas(y1 - y0, x1 - x0, 32.0, b.choices.colour((240, 240, 236), dv=0.05))
+    c = tx.Canvas(y1 - y0, x1 - x0, 32.0, b.choices.color((240, 240, 236), dv=0.05))
     if panels:
         for u in np.arange(0.9, y1 - y0 - 0.9, 1.8):
             for v in np.arange(0.9, x1 - x0 - 1.2, 2.4):
@@ -240,8 +242,8 @@ def workstation(b: Builder, room: Room, side: str, u0: float, width: float = 1.6
     """
     v, rng = b.choices, b.rng
     depth, top = 0.75, 0.74
-    wood = v.colour((200, 170, 125), dh=0.05, ds=0.2, dv=0.2)
-    leg = v.colour((90, 90, 95), dv=0.2)
+    wood = v.color((200, 170, 125), dh=0.05, ds=0.2, dv=0.2)
+    leg = v.color((90, 90, 95), dv=0.2)
     parts = [room.box(side, u0, u0 + width, 0.0, depth, top - 0.04, top, wood)]
     for uu in (u0 + 0.03, u0 + width - 0.08):
         for dd in (0.04, depth - 0.09):
@@ -288,7 +290,7 @@ def chair(b: Builder, room: Room, side: str, uc: float, d0: float) -> None:
         Distance of its front from the wall (m).
     """
     v = b.choices
-    seat = v.colour((45, 70, 150), dh=0.5, ds=0.3, dv=0.3)
+    seat = v.color((45, 70, 150), dh=0.5, ds=0.3, dv=0.3)
     dark = (35, 35, 38)
     dc = d0 + 0.25
     parts = [
@@ -352,7 +354,7 @@ def shelf(
             bw = float(min(rng.uniform(0.12, 0.4), u0 + width - t - 0.02 - u))
             if rng.uniform() < 0.8:
                 zt = z0 + 0.025 + (z1 - z0 - 0.04) * rng.uniform(0.65 if binders else 0.55, 0.95)
-                c = tx.random_colour(rng, s=(0.4, 1.0), v=(0.35, 0.95))
+                c = tx.random_color(rng, s=(0.4, 1.0), v=(0.35, 0.95))
                 dd = depth - 0.03 if binders else depth - 0.06
                 parts.append(room.box(side, u, u + bw, 0.03, dd, z0 + 0.025, zt, c))
             u += bw + 0.01
@@ -479,7 +481,7 @@ def sofa(b: Builder, room: Room, side: str, u0: float, width: float, rgb: RGB) -
             room.box(side, ua + 0.01, ua + cw - 0.01, 0.3, depth - 0.02, 0.42, 0.53, c * 1.05)
         )
     for ua in (u0 + 0.25, u0 + width - 0.65):
-        pillow = tx.random_colour(rng, s=(0.5, 1.0), v=(0.6, 1.0))
+        pillow = tx.random_color(rng, s=(0.5, 1.0), v=(0.6, 1.0))
         parts.append(room.box(side, ua, ua + 0.4, 0.3, 0.45, 0.53, 0.88, pillow))
     for ua in (u0 + 0.03, u0 + width - 0.08):
         parts.append(room.box(side, ua, ua + 0.05, 0.1, 0.15, 0.0, 0.08, (50, 35, 25)))
@@ -531,7 +533,7 @@ def sun(b: Builder, canonical: tuple[float, float, float]) -> tuple[float, float
     return (vec[0] / n, vec[1] / n, vec[2] / n)
 
 
-def wall_colours(b: Builder, canonical: RGB) -> dict[str, np.ndarray]:
+def wall_colors(b: Builder, canonical: RGB) -> dict[str, np.ndarray]:
     """The same paint on all walls (canonical) or a random light paint (randomised).
 
     Parameters
@@ -556,3 +558,7 @@ def wall_colours(b: Builder, canonical: RGB) -> dict[str, np.ndarray]:
     else:
         base = np.asarray(canonical, np.float32)
     return {s: base for s in "ENWS"}
+
+
+# deprecated: wall_colours, the British spelling of wall_colors, served for one release
+__getattr__ = moved_names(__name__, {"wall_colours": (sys.modules[__name__], "wall_colors")})

@@ -19,7 +19,7 @@ from vc_gym.sim.scenes.furniture import (
     shelf,
     sofa,
     sun,
-    wall_colours,
+    wall_colors,
     window,
 )
 from vc_gym.sim.scenes.registry import register_scene
@@ -34,15 +34,15 @@ def build_home(b: Builder) -> SceneLayout:
     """Build the home scene (see the module docstring) with ``b``."""
     v, rng = b.choices, b.rng
     bounds, field_b, height = (-2.75, 2.75, -2.4, 2.4), (-1.5, 1.5, -1.2, 1.2), 2.6
-    colours = wall_colours(b, (236, 218, 186))
+    colors = wall_colors(b, (236, 218, 186))
     if v.randomize and rng.uniform() < 0.5:  # warm paints in randomised homes
-        colours = {
+        colors = {
             s: tx.hsv(rng.uniform(0.0, 0.15), rng.uniform(0.15, 0.45), rng.uniform(0.7, 0.92))
             for s in "ENWS"
         }
     accent = v.choice("N", ("E", "N", "W", "S"))
-    colours[accent] = v.colour((185, 105, 75), dh=0.06, ds=0.15, dv=0.15)
-    room = Room(b, bounds, height, colours)
+    colors[accent] = v.color((185, 105, 75), dh=0.06, ds=0.15, dv=0.15)
+    room = Room(b, bounds, height, colors)
     for wall in room.walls.values():
         baseboard(wall, (245, 242, 235), 0.1)
         wall.canvas.mottle(rng, 0.02, 1.0)
@@ -52,16 +52,16 @@ def build_home(b: Builder) -> SceneLayout:
     # sofa with paintings above it, lamp and side table
     sofa_w = v.uniform(2.2, 1.8, 2.4)
     su = v.uniform(1.6, 1.2, 2.9)
-    sofa(b, room, sofa_side, su, sofa_w, v.colour((170, 60, 45), dh=0.5, ds=0.3, dv=0.2))
+    sofa(b, room, sofa_side, su, sofa_w, v.color((170, 60, 45), dh=0.5, ds=0.3, dv=0.2))
     floor_lamp(b, room, sofa_side, su - 0.35, 0.35)
     st = su + sofa_w + 0.1
     if st + 0.5 < 5.3:
-        wood = v.colour((120, 80, 50), dv=0.15)
+        wood = v.color((120, 80, 50), dv=0.15)
         b.solid(
             [
                 room.box(sofa_side, st, st + 0.5, 0.05, 0.55, 0.52, 0.56, wood),
                 room.box(sofa_side, st + 0.05, st + 0.45, 0.1, 0.5, 0.0, 0.52, wood * 0.8),
-                room.cyl(sofa_side, st + 0.25, 0.3, 0.56, 0.8, 0.07, tx.random_colour(rng)),
+                room.cyl(sofa_side, st + 0.25, 0.3, 0.56, 0.8, 0.07, tx.random_color(rng)),
             ]
         )
         room.walls[sofa_side].take(st, st + 0.5, 0.0, 0.85)
@@ -69,7 +69,7 @@ def build_home(b: Builder) -> SceneLayout:
 
     # TV on a low cabinet, plant, window with curtains
     tu = v.uniform(1.95, 1.2, 2.5)
-    tv_parts = cabinet(b, room, tv_side, tu, 1.6, 0.5, v.colour((80, 55, 40), dv=0.2))
+    tv_parts = cabinet(b, room, tv_side, tu, 1.6, 0.5, v.color((80, 55, 40), dv=0.2))
     tc = tu + 0.8
     tv_parts.append(room.box(tv_side, tc - 0.15, tc + 0.15, 0.1, 0.3, 0.5, 0.53, (20, 20, 22)))
     tv_parts.append(room.box(tv_side, tc - 0.04, tc + 0.04, 0.14, 0.18, 0.53, 0.65, (20, 20, 22)))
@@ -79,15 +79,15 @@ def build_home(b: Builder) -> SceneLayout:
     b.mesh([room.quad(tv_side, tc - 0.58, tc + 0.58, 0.66, 1.29, 0.202)], show)
     room.walls[tv_side].take(tu, tu + 1.6, 0.0, 1.4)
     plant(b, room, tv_side, v.uniform(0.45, 0.35, 0.8), 0.35)
-    curtain = v.colour((150, 40, 50), dh=0.5, ds=0.2, dv=0.2)
+    curtain = v.color((150, 40, 50), dh=0.5, ds=0.2, dv=0.2)
     win_u = v.uniform(4.3, 4.0, 4.5) if tu + 1.6 < 3.9 else 0.9
     window(b, room.walls[tv_side], win_u - 0.2, win_u + 0.65, 1.0, 2.15, curtains=curtain)
 
     # bookshelf and armchair on one end wall, window, sideboard and clock on the other
     shelf_side = v.choice("E", ("E", "W"))
     other = "W" if shelf_side == "E" else "E"
-    shelf(b, room, shelf_side, v.uniform(2.6, 2.4, 3.3), 1.2, 1.95, 0.35, v.colour((110, 75, 45)))
-    arm = v.colour((70, 110, 90), dh=0.5, ds=0.2, dv=0.2)
+    shelf(b, room, shelf_side, v.uniform(2.6, 2.4, 3.3), 1.2, 1.95, 0.35, v.color((110, 75, 45)))
+    arm = v.color((70, 110, 90), dh=0.5, ds=0.2, dv=0.2)
     au = v.uniform(0.7, 0.3, 1.0)
     parts = [
         room.box(shelf_side, au, au + 0.85, 0.1, 0.9, 0.1, 0.42, arm),
@@ -101,8 +101,8 @@ def build_home(b: Builder) -> SceneLayout:
     door(b, room.walls[shelf_side], v.uniform(3.95, 3.9, 3.95), 0.85)
     o = room.walls[other]
     window(b, o, 1.5, 3.3, 0.95, 2.1, radiator=False, curtains=curtain)
-    sb = cabinet(b, room, other, 0.25, 1.0, 0.85, v.colour((95, 60, 40), dv=0.15))
-    sb.append(room.cyl(other, 0.55, 0.22, 0.85, 1.15, 0.08, tx.random_colour(rng)))
+    sb = cabinet(b, room, other, 0.25, 1.0, 0.85, v.color((95, 60, 40), dv=0.15))
+    sb.append(room.cyl(other, 0.55, 0.22, 0.85, 1.15, 0.08, tx.random_color(rng)))
     b.solid(sb)
     o.canvas.clock(4.1, 1.95, 0.18, (90, 60, 35))
     o.take(3.9, 4.3, 1.75, 2.15)
@@ -112,7 +112,7 @@ def build_home(b: Builder) -> SceneLayout:
             hang_pictures(b, room.walls[side], v.integers(3, 2, 4), (0.7, 2.2), (0.5, 1.2), True)
 
     # floor: wooden boards with a big patterned rug under the free area
-    wood = v.colour((160, 110, 70), dh=0.03, ds=0.15, dv=0.15)
+    wood = v.color((160, 110, 70), dh=0.03, ds=0.15, dv=0.15)
     floor = tx.Canvas(5.5, 4.8, FLOOR_PPM, wood)
     bw = 0.18
     for i in range(int(4.8 / bw) + 1):
@@ -122,8 +122,8 @@ def build_home(b: Builder) -> SceneLayout:
             floor.shade(x, x + ln - 0.01, i * bw, (i + 1) * bw - 0.01, rng.uniform(0.88, 1.1))
             x += ln
     floor.mottle(rng, 0.03, 0.5)
-    rug = v.colour((150, 40, 40), dh=0.5, ds=0.2, dv=0.2)
-    border = v.colour((230, 200, 120), dh=0.5, ds=0.2, dv=0.1)
+    rug = v.color((150, 40, 40), dh=0.5, ds=0.2, dv=0.2)
+    border = v.color((230, 200, 120), dh=0.5, ds=0.2, dv=0.1)
     rx0, rx1, ry0, ry1 = 1.15, 4.35, 1.3, 3.5
     floor.rect(rx0, rx1, ry0, ry1, border)
     floor.rect(rx0 + 0.15, rx1 - 0.15, ry0 + 0.15, ry1 - 0.15, rug)

@@ -18,7 +18,7 @@ from vc_gym.sim.scenes.furniture import (
     plant,
     shelf,
     sun,
-    wall_colours,
+    wall_colors,
     window,
     workstation,
 )
@@ -34,10 +34,10 @@ def build_office(b: Builder) -> SceneLayout:
     """Build the office scene (see the module docstring) with ``b``."""
     v, rng = b.choices, b.rng
     bounds, field_b, height = (-3.0, 3.0, -2.5, 2.5), (-2.0, 2.0, -1.0, 1.0), 2.7
-    colours = wall_colours(b, (240, 240, 236))
+    colors = wall_colors(b, (240, 240, 236))
     accent = v.choice("W", ("E", "N", "W", "S"))
-    colours[accent] = v.colour((70, 140, 150), dh=0.5, ds=0.25, dv=0.2)
-    room = Room(b, bounds, height, colours)
+    colors[accent] = v.color((70, 140, 150), dh=0.5, ds=0.25, dv=0.2)
+    room = Room(b, bounds, height, colors)
     for wall in room.walls.values():
         baseboard(wall, (70, 72, 78), 0.1)
         wall.canvas.mottle(rng, 0.015, 1.0)
@@ -57,7 +57,7 @@ def build_office(b: Builder) -> SceneLayout:
     shelf_side = v.choice("E", ("E", "W"))
     board_side = "W" if shelf_side == "E" else "E"
     u = v.uniform(0.4, 0.2, 1.2)
-    frame = v.colour((150, 155, 160), dh=0.5, ds=0.2, dv=0.2)
+    frame = v.color((150, 155, 160), dh=0.5, ds=0.2, dv=0.2)
     for _ in range(v.integers(3, 2, 4)):
         if u + 0.9 > 4.8:
             break
@@ -65,11 +65,11 @@ def build_office(b: Builder) -> SceneLayout:
         u += 0.92
     # windows with blinds, filing cabinets and a plant
     win = room.walls[window_side]
-    blinds = v.colour((215, 215, 210), dh=0.5, ds=0.3, dv=0.1)
+    blinds = v.color((215, 215, 210), dh=0.5, ds=0.3, dv=0.1)
     for uc in (1.6, 4.4) if not v.randomize else sorted(rng.uniform(1.2, 4.8, 2)):
         if win.free(uc - 0.75, uc + 0.75, 0.8, 2.3, 0.05):
             window(b, win, uc - 0.75, uc + 0.75, 0.8, 2.3, blinds=blinds)
-    cab_rgb = v.colour((120, 125, 135), dh=0.5, ds=0.3, dv=0.2)
+    cab_rgb = v.color((120, 125, 135), dh=0.5, ds=0.3, dv=0.2)
     cu = v.uniform(0.15, 0.1, 0.4)
     parts = cabinet(b, room, window_side, cu, 0.5, 1.05, cab_rgb)
     parts += cabinet(b, room, window_side, cu + 0.52, 0.5, 1.05, cab_rgb)
@@ -96,7 +96,7 @@ def build_office(b: Builder) -> SceneLayout:
         hang_pictures(b, room.walls[side], v.integers(4, 3, 5), (0.6, 2.1))
 
     # floor: blue-grey carpet tiles; ceiling with light panels
-    floor = tx.Canvas(6.0, 5.0, FLOOR_PPM, v.colour((95, 105, 125), dh=0.5, ds=0.2, dv=0.15))
+    floor = tx.Canvas(6.0, 5.0, FLOOR_PPM, v.color((95, 105, 125), dh=0.5, ds=0.2, dv=0.15))
     for i in range(12):
         for j in range(10):
             floor.shade(i * 0.5, i * 0.5 + 0.5, j * 0.5, j * 0.5 + 0.5, rng.uniform(0.93, 1.07))

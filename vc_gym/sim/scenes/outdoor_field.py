@@ -30,7 +30,7 @@ def build_outdoor_field(b: Builder) -> SceneLayout:
     radius, sky_h, ground = 34.0, 22.0, 35.0
 
     # grass: mowing stripes, white lines of a 44 x 28 m pitch
-    g = v.colour((70, 135, 55), dh=0.03, ds=0.15, dv=0.12)
+    g = v.color((70, 135, 55), dh=0.03, ds=0.15, dv=0.12)
     c = tx.Canvas(2 * ground, 2 * ground, 20.0, g)
     stripe = v.uniform(4.0, 3.0, 6.0)
     x = ground - 22.0
@@ -125,7 +125,7 @@ def build_outdoor_field(b: Builder) -> SceneLayout:
             parts.append(box(sx - 1.0, sx + 1.0, sy - 0.2, sy + 0.2, 13.6, 14.8, (235, 235, 225)))
     b.solid(parts, collide=False)
     stand_side = v.choice(1.0, (1.0, -1.0))
-    _grandstand(b, stand_side, v.colour((30, 80, 170), dh=0.5, ds=0.2, dv=0.2))
+    _grandstand(b, stand_side, v.color((30, 80, 170), dh=0.5, ds=0.2, dv=0.2))
     # buildings behind the goals and the far touchline (the diagonals hold the masts),
     # trees elsewhere
     sectors = [k for k in range(4) if k != (1 if stand_side > 0 else 3)]
@@ -181,10 +181,10 @@ def _grandstand(b: Builder, side: float, seat: RGB) -> None:
     for s in range(4):
         y0, y1 = ys(s, s + 1.0)
         parts.append(box(-12.0, 12.0, y0, y1, 0.0, 0.5 + s * 0.5, concrete))
-        colour = seat if s % 2 == 0 else seat * np.float32(0.8)
-        parts.append(box(-12.0, 12.0, y0, y1, 0.5 + s * 0.5, 0.8 + s * 0.5, colour))
+        color = seat if s % 2 == 0 else seat * np.float32(0.8)
+        parts.append(box(-12.0, 12.0, y0, y1, 0.5 + s * 0.5, 0.8 + s * 0.5, color))
     parts.append(box(-12.2, 12.2, *ys(4.0, 4.3), 0.0, 4.2, grey))
-    roof = b.choices.colour((180, 40, 40), dh=0.5)
+    roof = b.choices.color((180, 40, 40), dh=0.5)
     parts.append(box(-12.5, 12.5, *ys(-0.5, 4.3), 4.2, 4.5, roof))
     for xp in (-12.0, 0.0, 12.0):
         parts.append(box(xp - 0.1, xp + 0.1, *ys(-0.4, -0.2), 0.0, 4.2, grey))

@@ -19,7 +19,7 @@ from vc_gym.sim.scenes.furniture import (
     hang_pictures,
     shelf,
     sun,
-    wall_colours,
+    wall_colors,
     window,
     workstation,
 )
@@ -55,14 +55,14 @@ def build_robolab(b: Builder) -> SceneLayout:
     """Build the robolab scene (see the module docstring) with ``b``."""
     v, rng = b.choices, b.rng
     bounds, field_b, height = (-3.5, 3.5, -3.5, 3.5), (-3.0, 3.0, -2.0, 2.0), 2.8
-    colours = wall_colours(b, (232, 228, 212))
+    colors = wall_colors(b, (232, 228, 212))
     desk_side = v.choice("N", ("N", "S"))
     window_side = "S" if desk_side == "N" else "N"
     accent_side = v.choice("W", ("E", "W", "none"))
     if accent_side != "none":
-        colours[accent_side] = v.colour((120, 160, 200), dh=0.5, ds=0.2, dv=0.15)
-    room = Room(b, bounds, height, colours)
-    base_rgb = v.colour((95, 95, 100), dh=0.5, ds=0.2, dv=0.2)
+        colors[accent_side] = v.color((120, 160, 200), dh=0.5, ds=0.2, dv=0.15)
+    room = Room(b, bounds, height, colors)
+    base_rgb = v.color((95, 95, 100), dh=0.5, ds=0.2, dv=0.2)
     for wall in room.walls.values():
         baseboard(wall, base_rgb)
         wall.canvas.mottle(rng, 0.02, 1.0)
@@ -82,7 +82,7 @@ def build_robolab(b: Builder) -> SceneLayout:
 
     # windows with radiators, a bookshelf and a cabinet with robot crates opposite
     win = room.walls[window_side]
-    shelf(b, room, window_side, v.uniform(0.15, 0.1, 0.4), 0.9, frame=v.colour((125, 90, 60)))
+    shelf(b, room, window_side, v.uniform(0.15, 0.1, 0.4), 0.9, frame=v.color((125, 90, 60)))
     n_win = v.integers(2, 1, 3)
     span0, span1 = 1.5, 5.6
     slot = (span1 - span0) / n_win
@@ -90,7 +90,7 @@ def build_robolab(b: Builder) -> SceneLayout:
         ww = v.uniform(1.5, 0.8, min(1.8, slot - 0.3))
         uc = span0 + (k + 0.5) * slot + v.uniform(0.0, -0.15, 0.15)
         window(b, win, uc - ww / 2, uc + ww / 2, 0.95, 2.3)
-    cab = cabinet(b, room, window_side, 5.85, 1.0, 0.75, v.colour((200, 200, 195)))
+    cab = cabinet(b, room, window_side, 5.85, 1.0, 0.75, v.color((200, 200, 195)))
     crates = [(210, 40, 40), (40, 90, 200), (240, 200, 30)]
     for k in range(2):
         c = crates[int(rng.integers(3))] if v.randomize else crates[k]
@@ -126,9 +126,9 @@ def build_robolab(b: Builder) -> SceneLayout:
 
     # floor: grey linoleum, the green carpet with coarse white lines
     fx0, fx1, fy0, fy1 = field_b
-    floor = tx.Canvas(7.0, 7.0, FLOOR_PPM, v.colour((165, 165, 160), dv=0.1))
+    floor = tx.Canvas(7.0, 7.0, FLOOR_PPM, v.color((165, 165, 160), dv=0.1))
     floor.mottle(rng, 0.04, 0.7)
-    green = v.colour((45, 120, 55), dh=0.03, ds=0.1, dv=0.1)
+    green = v.color((45, 120, 55), dh=0.03, ds=0.1, dv=0.1)
     sx, sy = fx0 - bounds[0], fy0 - bounds[2]  # field corner in canvas coordinates
     carpet = tx.Canvas(fx1 - fx0, fy1 - fy0, FLOOR_PPM, green)
     carpet.mottle(rng, 0.06, 0.5)

@@ -14,13 +14,14 @@
   (``loadTexture`` memory is freed only by ``resetSimulation``/``disconnect``), deletes
   each file right after loading and the folder when it is closed.
 
-The colour helpers :func:`hsv`, :func:`random_colour` and :func:`smooth_noise` of
+The colour helpers :func:`hsv`, :func:`random_color` and :func:`smooth_noise` of
 :mod:`vc_gym.worlds.paint` are re-exported here for scene builders.
 
 All images are ``(H, W, 3)`` ``uint8`` RGB arrays; row 0 is the top of the picture. All
 randomness comes from the ``numpy.random.Generator`` passed in.
 """
 
+from vc_gym.deprecation import moved_names
 from vc_gym.sim.textures.painters import (
     POSTER_STYLES,
     ad_board,
@@ -40,8 +41,9 @@ from vc_gym.sim.textures.photos import (
     sample_photo,
 )
 from vc_gym.sim.textures.store import TEXTURE_DIR_PREFIX, TextureStore
+from vc_gym.worlds import paint as _paint
 from vc_gym.worlds.canvas import Canvas
-from vc_gym.worlds.paint import hsv, random_colour, smooth_noise
+from vc_gym.worlds.paint import hsv, random_color, smooth_noise
 
 __all__ = [
     "Canvas",
@@ -58,10 +60,13 @@ __all__ = [
     "photo_posters",
     "poster_image",
     "procedural_poster",
-    "random_colour",
+    "random_color",
     "sample_photo",
     "sky_band",
     "sky_cap",
     "smooth_noise",
     "TEXTURE_DIR_PREFIX",
 ]
+
+# deprecated: random_colour, the British spelling of random_color, served for one release
+__getattr__ = moved_names(__name__, {"random_colour": (_paint, "random_color")})

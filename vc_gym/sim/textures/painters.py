@@ -22,7 +22,7 @@ import numpy as np
 
 from vc_gym.sim.textures.photos import MAP_IMAGES, map_image, photo_posters
 from vc_gym.worlds.canvas import Canvas
-from vc_gym.worlds.paint import hsv, random_colour, smooth_noise, to_uint8
+from vc_gym.worlds.paint import hsv, random_color, smooth_noise, to_uint8
 
 __all__ = [
     "POSTER_STYLES",
@@ -96,7 +96,7 @@ def procedural_poster(
     if style not in POSTER_STYLES:
         raise ValueError(f"style must be one of {POSTER_STYLES}, got {style!r}")
     img = np.empty((h, w, 3), np.float32)
-    img[:] = random_colour(rng, s=(0.2, 0.9), v=(0.55, 1.0))
+    img[:] = random_color(rng, s=(0.2, 0.9), v=(0.55, 1.0))
     yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
     xx /= w
     yy /= h
@@ -126,11 +126,11 @@ def procedural_poster(
         for _ in range(int(rng.integers(2, 6))):
             cx, cy, r = rng.uniform(0.15, 0.85), rng.uniform(0.15, 0.85), rng.uniform(0.12, 0.35)
             d = np.hypot((xx - cx) * w / m, (yy - cy) * h / m)
-            colour = random_colour(rng)
+            color = random_color(rng)
             if rng.uniform() < 0.35:
-                img[(d < r) & (d > r * rng.uniform(0.45, 0.7))] = colour
+                img[(d < r) & (d > r * rng.uniform(0.45, 0.7))] = color
             else:
-                img[d < r] = colour
+                img[d < r] = color
     elif style == "bands":
         angle = rng.choice([0.0, 0.0, 90.0, 45.0, -45.0])
         a = math.radians(float(angle))
@@ -138,7 +138,7 @@ def procedural_poster(
         edges = np.sort(rng.uniform(t.min(), t.max(), int(rng.integers(2, 5))))
         for lo, hi in itertools.pairwise([t.min() - 1, *edges, t.max() + 1]):
             if hi - lo > 0.06:
-                img[(t >= lo) & (t < hi)] = random_colour(rng, s=(0.4, 1.0))
+                img[(t >= lo) & (t < hi)] = random_color(rng, s=(0.4, 1.0))
     elif style == "landscape":
         hue = rng.uniform(0.0, 1.0)
         top = hsv(hue, rng.uniform(0.4, 0.8), rng.uniform(0.5, 0.9))
@@ -160,11 +160,11 @@ def procedural_poster(
                     + 0.5 * np.sin(freq[1] * math.pi * xx[0] + phase[1])
                 )
             )
-            colour = hsv(rng.uniform(0.2, 0.45), rng.uniform(0.4, 0.8), 0.75 - 0.18 * k)
-            img[yy > ridge[None, :]] = colour
+            color = hsv(rng.uniform(0.2, 0.45), rng.uniform(0.4, 0.8), 0.75 - 0.18 * k)
+            img[yy > ridge[None, :]] = color
     elif style == "chart":
         img[:] = (245, 245, 240)
-        accent = random_colour(rng, s=(0.6, 1.0), v=(0.4, 0.8))
+        accent = random_color(rng, s=(0.6, 1.0), v=(0.4, 0.8))
         head = int(0.2 * h)
         img[:head] = accent
         _text(
@@ -176,7 +176,7 @@ def procedural_poster(
         bw = (x1 - x0) / n
         for i in range(n):
             top = int(y1 - rng.uniform(0.2, 1.0) * (y1 - y0))
-            img[top:y1, int(x0 + i * bw + 0.15 * bw) : int(x0 + (i + 0.85) * bw)] = random_colour(
+            img[top:y1, int(x0 + i * bw + 0.15 * bw) : int(x0 + (i + 0.85) * bw)] = random_color(
                 rng
             )
         img[y1 : y1 + max(2, h // 60), x0:x1] = 40
@@ -184,7 +184,7 @@ def procedural_poster(
         for y in range(int(0.3 * h), int(0.9 * h) - row, 2 * row):
             img[y : y + row, int(0.62 * w) : int(rng.uniform(0.75, 0.93) * w)] = 150
     else:  # text
-        img[:] = random_colour(rng, s=(0.5, 1.0), v=(0.3, 0.9))
+        img[:] = random_color(rng, s=(0.5, 1.0), v=(0.3, 0.9))
         fg = (255, 255, 255) if rng.uniform() < 0.6 else (250, 220, 40)
         word = str(rng.choice(_WORDS))
         if h > 1.3 * w and len(word) > 2:  # portrait: a big word and a second one
@@ -192,7 +192,7 @@ def procedural_poster(
             _text(img, str(rng.choice(_WORDS)), fg, (0, int(0.55 * h), w, int(0.9 * h)))
         else:
             _text(img, word, fg, (int(0.05 * w), int(0.1 * h), int(0.95 * w), int(0.9 * h)))
-        img[int(0.92 * h) :] = random_colour(rng)
+        img[int(0.92 * h) :] = random_color(rng)
     return to_uint8(img)
 
 
@@ -256,7 +256,7 @@ def outdoor_view(rng: np.random.Generator, height: int = 96, width: int = 128) -
         bx0 = int(rng.uniform(0.1, 0.6) * width)
         bx1 = bx0 + int(rng.uniform(0.2, 0.4) * width)
         by = int(horizon - rng.uniform(0.3, 0.5) * height)
-        img[by:horizon, bx0:bx1] = random_colour(rng, s=(0.1, 0.4), v=(0.5, 0.9))
+        img[by:horizon, bx0:bx1] = random_color(rng, s=(0.1, 0.4), v=(0.5, 0.9))
     img[horizon:] = hsv(rng.uniform(0.22, 0.3), 0.55, 0.6)
     return to_uint8(img)
 
@@ -270,13 +270,13 @@ def desktop_screen(rng: np.random.Generator, height: int = 60, width: int = 96) 
         ``(height, width, 3)`` ``uint8`` RGB.
     """
     img = np.empty((height, width, 3), np.float32)
-    img[:] = random_colour(rng, s=(0.4, 0.9), v=(0.35, 0.8))
+    img[:] = random_color(rng, s=(0.4, 0.9), v=(0.35, 0.8))
     for _ in range(int(rng.integers(1, 4))):
         x0, y0 = int(rng.uniform(0.0, 0.5) * width), int(rng.uniform(0.0, 0.4) * height)
         x1 = x0 + int(rng.uniform(0.35, 0.6) * width)
         y1 = y0 + int(rng.uniform(0.4, 0.6) * height)
-        img[y0:y1, x0:x1] = random_colour(rng, s=(0.0, 0.3), v=(0.8, 1.0))
-        img[y0 : y0 + max(3, height // 10), x0:x1] = random_colour(rng, s=(0.5, 1.0), v=(0.4, 0.8))
+        img[y0:y1, x0:x1] = random_color(rng, s=(0.0, 0.3), v=(0.8, 1.0))
+        img[y0 : y0 + max(3, height // 10), x0:x1] = random_color(rng, s=(0.5, 1.0), v=(0.4, 0.8))
     return to_uint8(img)
 
 
@@ -289,8 +289,8 @@ def ad_board(rng: np.random.Generator, height: int = 32, width: int = 128) -> np
         ``(height, width, 3)`` ``uint8`` RGB.
     """
     img = np.empty((height, width, 3), np.float32)
-    img[:] = random_colour(rng, s=(0.6, 1.0), v=(0.5, 1.0))
-    fg = (255, 255, 255) if rng.uniform() < 0.5 else random_colour(rng, v=(0.9, 1.0))
+    img[:] = random_color(rng, s=(0.6, 1.0), v=(0.5, 1.0))
+    fg = (255, 255, 255) if rng.uniform() < 0.5 else random_color(rng, v=(0.9, 1.0))
     word = str(rng.choice(("VC GYM", "ROBO", "KICK", "SPORT", "CLUB", "CAFE", "GOAL", "PLAY")))
     _text(img, word, fg, (int(0.06 * width), 2, int(0.94 * width), height - 2))
     return to_uint8(img)
@@ -315,7 +315,7 @@ def facade(
     numpy.ndarray
         ``uint8`` RGB image of the facade (row 0 is its top).
     """
-    c = Canvas(width_m, height_m, px_per_m, random_colour(rng, s=(0.05, 0.5), v=(0.45, 0.9)))
+    c = Canvas(width_m, height_m, px_per_m, random_color(rng, s=(0.05, 0.5), v=(0.45, 0.9)))
     glass = hsv(rng.uniform(0.52, 0.65), rng.uniform(0.2, 0.5), rng.uniform(0.2, 0.45))
     floor_h = rng.uniform(2.8, 3.4)
     win_w, pitch = rng.uniform(1.0, 1.8), rng.uniform(2.4, 3.4)
@@ -328,7 +328,7 @@ def facade(
             c.rect(x - win_w / 2, x + win_w / 2, z, z + floor_h * 0.55, glass)
         z += floor_h
     c.rect(width_m / 2 - 0.7, width_m / 2 + 0.7, 0.0, 2.3, hsv(0.08, 0.5, 0.3))
-    c.rect(0.0, width_m, height_m - 0.5, height_m, random_colour(rng, s=(0.2, 0.6), v=(0.3, 0.6)))
+    c.rect(0.0, width_m, height_m - 0.5, height_m, random_color(rng, s=(0.2, 0.6), v=(0.3, 0.6)))
     return c.image()
 
 
@@ -379,7 +379,7 @@ def sky_band(
         bw = int(rng.uniform(0.01, 0.03) * width)
         bx = int(rng.integers(0, width - bw))
         top = int((1.0 - horizon * rng.uniform(0.8, 1.6)) * height)
-        img[top:, bx : bx + bw] = random_colour(rng, s=(0.0, 0.3), v=(0.55, 0.85))
+        img[top:, bx : bx + bw] = random_color(rng, s=(0.0, 0.3), v=(0.55, 0.85))
     return to_uint8(img)
 
 

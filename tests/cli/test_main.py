@@ -1,0 +1,38 @@
+"""``vc_gym.cli.main``: Ctrl-C at any point is one line, and moved constants still work."""
+
+from __future__ import annotations
+
+import pytest
+
+import vc_gym.cli as cli
+
+
+def _interrupted(*args, **kwargs):
+    raise KeyboardInterrupt
+
+
+def test_ctrl_c_while_the_commands_load_is_one_line(monkeypatch, capsys):
+    monkeypatch.setattr(cli, "build_parser", _interrupted)
+    assert cli.main(["demo"]) == cli.EXIT_INTERRUPTED
+    assert capsys.readouterr().err == "vc-gym: interrupted\n"
+
+
+def test_importing_the_package_loads_no_command():
+    import subprocess
+    import sys
+
+    code = "import sys, vc_gym.cli; print(any(m.startswith('vc_gym.cli.') for m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize(
+    ("name", "where"),
+    [("MAX_BENCH_REPEATS", "vc_gym.cli.bench"), ("MAX_VIDEOS", "vc_gym.experiments.options")],
+)
+def test_moved_constants_warn_and_are_the_same(name, where):
+    import importlib
+
+    with pytest.warns(DeprecationWarning, match=f"moved to {where}.{name}"):
+        value = getattr(cli, name)
+    assert value == getattr(importlib.import_module(where), name)
