@@ -21,7 +21,10 @@ def test_importing_the_package_loads_no_command():
     import subprocess
     import sys
 
-    code = "import sys, vc_gym.cli; print(any(m.startswith('vc_gym.cli.') for m in sys.modules))"
+    code = (
+        "import sys, vc_gym.cli as c; "
+        "print(any(f'vc_gym.cli.{n}' in sys.modules for n in c.COMMANDS))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 
@@ -36,3 +39,18 @@ def test_moved_constants_warn_and_are_the_same(name, where):
     with pytest.warns(DeprecationWarning, match=f"moved to {where}.{name}"):
         value = getattr(cli, name)
     assert value == getattr(importlib.import_module(where), name)
+
+
+@pytest.mark.parametrize("command", ["demo", "evaluate", "bench", "train", "soak", "check"])
+def test_help_shows_the_defaults(command, capsys):
+    with pytest.raises(SystemExit):
+        cli.main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "(default: " in text
+    assert "(default: None)" not in text and "(default: False)" not in text
+
+
+def test_a_zero_default_is_shown():
+    parser = cli.build_parser()
+    demo = parser._subparsers._group_actions[0].choices["demo"]
+    assert "(default: 0)" in " ".join(demo.format_help().split())

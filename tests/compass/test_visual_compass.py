@@ -422,3 +422,13 @@ def test_a_noisy_camera_frame_still_gives_its_heading(room_pano, room_compass):
     noisy = np.clip(view + rng.normal(0.0, 8.0, view.shape), 0, 255).astype(np.uint8)
     est = room_compass.estimate(noisy, Camera())
     assert est.n_sectors > 0 and abs(wrap180(est.heading_deg - 75.0)) < 5.0
+
+
+def test_an_estimate_prints_in_one_short_line():
+    from vc_gym.compass.visual_compass import CompassEstimate
+
+    text = repr(CompassEstimate(12.3456, 0.5, -1.23456, 7, np.zeros(360)))
+    assert text == (
+        "CompassEstimate(heading_deg=12.35, spread_deg=0.50, score=-1.2346, n_sectors=7, "
+        "log_likelihood=<360 headings>)"
+    )

@@ -236,7 +236,7 @@ def test_previous_action_appends_the_last_action_taken():
     checked = gym.make("vc_gym/Homing-v0", previous_action=True, **FAST)
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
-        check_env(checked, skip_render_check=True)  # as the agent sees it
+        check_env(checked)  # as the agent sees it
         sb3_check_env(checked, warn=True)
     checked.close()
     problems = [str(w.message) for w in record if "unwrapped version" not in str(w.message)]

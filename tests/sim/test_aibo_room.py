@@ -63,7 +63,7 @@ def test_gymnasium_check_env(env_id, scene):
     wrapped = env_id in WRAPPED
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
-        check_env(env if wrapped else env.unwrapped, skip_render_check=True)
+        check_env(env if wrapped else env.unwrapped)
     env.close()
     problems = [m for m in _filtered(record) if not (wrapped and "unwrapped version" in m)]
     assert not problems, problems
@@ -168,9 +168,11 @@ def test_the_top_views_background_does_not_keep_the_robot_where_it_first_stood()
 
 
 def test_render_human_without_display_is_a_clear_error(monkeypatch):
-    monkeypatch.delenv("DISPLAY", raising=False)
+    from vc_gym.sim import aibo_room
+
+    monkeypatch.setattr(aibo_room, "display_available", lambda: False)
     with pytest.raises(RuntimeError, match="display"):
-        gym.make("vc_gym/AiboRoom-v0", render_mode="human")
+        aibo_room.AiboRoomEnv(render_mode="human")
 
 
 def test_a_step_before_the_first_reset_is_refused():
@@ -386,3 +388,29 @@ def test_a_lost_physics_server_is_a_clear_error_and_reset_rebuilds_the_world():
     np.testing.assert_array_equal(first["image"], again["image"])
     env.step(np.zeros(5, np.float32))
     env.close()
+
+
+@pytest.mark.parametrize(
+    ("platform", "env", "expected"),
+    [
+        ("linux", {}, False),
+        ("linux", {"DISPLAY": ":0"}, True),
+        ("linux", {"WAYLAND_DISPLAY": "wayland-0"}, True),
+        ("darwin", {}, True),
+    ],
+)
+def test_a_display_is_found_where_there_is_one(monkeypatch, platform, env, expected):
+    from vc_gym.sim import aibo_room
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    for key, value in env.items():
+        monkeypatch.setenv(key, value)
+    monkeypatch.setattr(aibo_room.sys, "platform", platform)
+    assert aibo_room.display_available() is expected
+
+
+def test_human_is_listed_only_where_a_window_can_open():
+    from vc_gym.sim.aibo_room import AiboRoomEnv, display_available
+
+    assert ("human" in AiboRoomEnv.metadata["render_modes"]) == display_available()

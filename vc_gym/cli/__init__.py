@@ -14,6 +14,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from vc_gym.cli.arguments import DefaultsFormatter, RawDescriptionDefaultsFormatter
 from vc_gym.deprecation import moved_names
 
 __all__ = ["COMMANDS", "EXIT_INTERRUPTED", "build_parser", "main"]
@@ -45,11 +46,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _remember_parsers(parser: argparse.ArgumentParser) -> None:
     """Let every (sub-)command's namespace know its own parser, so that an unknown flag
-    is reported with that command's usage, not the top level's."""
+    is reported with that command's usage, not the top level's; and let each show its
+    options' defaults in ``--help``."""
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
             for sub in action.choices.values():
                 sub.set_defaults(parser=sub)
+                raw = issubclass(sub.formatter_class, argparse.RawDescriptionHelpFormatter)
+                sub.formatter_class = RawDescriptionDefaultsFormatter if raw else DefaultsFormatter
                 _remember_parsers(sub)
 
 

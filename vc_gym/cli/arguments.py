@@ -9,6 +9,8 @@ from typing import Any
 from vc_gym.experiments.options import Option, parse_tracker_spec
 
 __all__ = [
+    "DefaultsFormatter",
+    "RawDescriptionDefaultsFormatter",
     "SceneChoices",
     "add_allow_imports_option",
     "add_json_option",
@@ -107,3 +109,24 @@ class SceneChoices:
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._names())
+
+
+class DefaultsFormatter(argparse.HelpFormatter):
+    """Help that shows each option's default where it has a value of its own and its
+    text does not already say it (``None``, ``False`` and ``--help`` add nothing)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        default = action.default
+        if (
+            action.option_strings
+            and not any(default is v for v in (None, False, argparse.SUPPRESS))
+            and "default" not in text.lower()
+            and "%(default)" not in text
+        ):
+            text += " (default: %(default)s)"
+        return text
+
+
+class RawDescriptionDefaultsFormatter(argparse.RawDescriptionHelpFormatter, DefaultsFormatter):
+    """:class:`DefaultsFormatter` keeping the description's own line breaks."""

@@ -24,7 +24,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "It is the first kidnapping of 'vc-gym evaluate' with the same --seed. Writes "
             "DIR/summary.json (home error, heading error, success, duration) and DIR/demo.png."
         ),
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument("--out", default="vc_gym_demo", metavar="DIR", help="output folder")
     p.add_argument(

@@ -28,7 +28,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "DIR/results.json, DIR/run.json and DIR/stop_positions.png, and resumes an "
             "interrupted run in the same DIR."
         ),
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument(
         "--agent",

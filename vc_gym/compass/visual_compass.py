@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -97,7 +97,15 @@ class CompassEstimate:
     spread_deg: float
     score: float
     n_sectors: int
-    log_likelihood: np.ndarray
+    log_likelihood: np.ndarray = field(repr=False)
+
+    def __repr__(self) -> str:
+        # the log-likelihood is one number per heading: its length says enough
+        return (
+            f"CompassEstimate(heading_deg={self.heading_deg:.2f}, "
+            f"spread_deg={self.spread_deg:.2f}, score={self.score:.4f}, "
+            f"n_sectors={self.n_sectors}, log_likelihood=<{len(self.log_likelihood)} headings>)"
+        )
 
 
 class VisualCompass:

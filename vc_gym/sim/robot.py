@@ -36,10 +36,9 @@ import os
 from collections.abc import Sequence
 
 import numpy as np
-import pybullet
-import pybullet_data
 
 from vc_gym.angles import wrap360
+from vc_gym.sim.bullet import pybullet, pybullet_data
 from vc_gym.sim.gait import (
     BODY_HEIGHT_M,
     FOOT_XY,

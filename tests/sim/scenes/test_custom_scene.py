@@ -137,7 +137,7 @@ def test_custom_scene_passes_the_env_checker(box_room_name):
     )
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
-        check_env(env.unwrapped, skip_render_check=True)
+        check_env(env.unwrapped)
     env.close()
     # SB3 prefers channel-first images; Gymnasium's convention (and ours) is HxWxC
     unexpected = [

@@ -15,10 +15,9 @@ import time
 
 import gymnasium as gym
 import numpy as np
-import pybullet
-from pybullet_utils import bullet_client
 
 import vc_gym  # noqa: F401  (registers the envs)
+from vc_gym.sim.bullet import connect, pybullet
 from vc_gym.sim.head_camera import HeadCameraSpec
 from vc_gym.sim.robot import Quadruped
 from vc_gym.sim.scenes import build_scene, check_scene_name
@@ -46,7 +45,7 @@ class _Bare:
     """The same scene, robot and camera, driven by raw PyBullet calls only."""
 
     def __init__(self, scene: str, control_dt: float, spec: HeadCameraSpec, seed: int):
-        self.bc = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
+        self.bc = connect(pybullet.DIRECT)
         build_scene(self.bc, scene, rng=np.random.default_rng(seed))
         robot = Quadruped(self.bc, "constraint", rng=np.random.default_rng(seed))
         robot.reset(0.0, 0.0, 30.0)
