@@ -392,8 +392,10 @@ def test_a_frame_without_colour_changes_gives_a_flat_likelihood(room_pano, room_
     assert np.all(ll == 0.0)
     est = room_compass.estimate(frame, Camera())
     assert est.n_sectors == 0 and est.spread_deg > 90.0
+    assert not est.has_evidence and est.heading_deg == 0.0
     true = room_compass.estimate(render_view(room_pano, Camera(yaw_deg=40.0)), Camera())
     assert true.n_sectors > 0 and abs(wrap180(true.heading_deg - 40.0)) < 3.0
+    assert true.has_evidence
 
 
 def _noise(kind: str, rng: np.random.Generator) -> np.ndarray:
@@ -412,7 +414,7 @@ def test_a_frame_of_noise_gives_a_flat_likelihood(room_pano, room_compass, kind)
     frame = _noise(kind, np.random.default_rng(3))
     assert np.all(room_compass.log_likelihood(frame, Camera()) == 0.0)
     est = room_compass.estimate(frame, Camera())
-    assert est.n_sectors == 0 and est.spread_deg > 90.0
+    assert est.n_sectors == 0 and est.spread_deg > 90.0 and not est.has_evidence
 
 
 def test_a_noisy_camera_frame_still_gives_its_heading(room_pano, room_compass):

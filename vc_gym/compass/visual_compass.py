@@ -79,8 +79,9 @@ class CompassEstimate:
         between grid points by a parabola through the peak and its neighbours).
     spread_deg : float
         Circular standard deviation (eq. 27) of the posterior ``∝ exp(log-likelihood)``
-        under a uniform prior. Small when one heading clearly wins, large (up to
-        infinity) when the image is ambiguous.
+        under a uniform prior. Small when one heading clearly wins, large when the image
+        is ambiguous: about 500° for a flat posterior (the resultant length of a uniform
+        posterior is zero only up to rounding), infinite for an exactly uniform one.
     score : float
         Goodness of fit: the mean log-probability per term (sector × class pair) of
         the image's features under the map at the best heading, ``<= 0``. It is
@@ -88,7 +89,9 @@ class CompassEstimate:
         goodness ``L`` of eq. 28 (``exp(score)`` is the geometric-mean likelihood
         per term).
     n_sectors : int
-        Number of sectors the image contributed (about ``hfov / sector_deg``).
+        Number of sectors the image contributed (about ``hfov / sector_deg``); ``0``
+        when it shows no usable colour change, and then :attr:`has_evidence` is false,
+        ``heading_deg`` is ``0.0`` and the spread is that of a flat posterior.
     log_likelihood : numpy.ndarray
         The full log-likelihood over :attr:`VisualCompass.headings_deg`.
     """
@@ -98,6 +101,12 @@ class CompassEstimate:
     score: float
     n_sectors: int
     log_likelihood: np.ndarray = field(repr=False)
+
+    @property
+    def has_evidence(self) -> bool:
+        """Whether the image said anything about the heading (``n_sectors > 0``); without
+        evidence the estimate is a placeholder a filter should not update on."""
+        return self.n_sectors > 0
 
     def __repr__(self) -> str:
         # the log-likelihood is one number per heading: its length says enough
