@@ -1,9 +1,10 @@
-"""Names that moved, still served from their old module for one release.
+"""Names that moved or were renamed, still served for one release.
 
 A module whose public names moved elsewhere sets ``__getattr__ = moved_names(__name__,
 {...})`` (PEP 562): reading an old name gives the very same object, with a
 ``DeprecationWarning`` naming its new place; any other missing name is an
-``AttributeError`` as usual.
+``AttributeError`` as usual. A value chosen by name (a mode, a registered plug-in) whose
+name changed goes through :func:`renamed`.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from collections.abc import Callable, Mapping
 from types import ModuleType
 from typing import Any
 
-__all__ = ["moved_names"]
+__all__ = ["moved_names", "renamed"]
 
 
 def moved_names(
@@ -48,3 +49,26 @@ def moved_names(
         return getattr(new_module, new_name)
 
     return __getattr__
+
+
+def renamed(kind: str, name: object, renames: Mapping[str, str], stacklevel: int = 2) -> object:
+    """``name``, or the name a deprecated ``name`` became (with a ``DeprecationWarning``).
+
+    Parameters
+    ----------
+    kind : str
+        What the name names, for the message (e.g. ``"homing mode"``).
+    name : object
+        The name given; anything not in ``renames`` is returned as is.
+    renames : mapping
+        Each deprecated name to its new one.
+    stacklevel : int
+        As :func:`warnings.warn`'s, counted from the caller of this function.
+    """
+    if not isinstance(name, str) or name not in renames:
+        return name
+    new = renames[name]
+    warnings.warn(
+        f"{kind} {name!r} is deprecated; use {new!r}", DeprecationWarning, stacklevel=stacklevel + 1
+    )
+    return new

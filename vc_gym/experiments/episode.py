@@ -13,7 +13,6 @@ is one) without changing what is recorded.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -25,6 +24,7 @@ from tqdm import tqdm
 from vc_gym.agents.learned import LearnedHomingAgent
 from vc_gym.agents.scripted import ScriptedHomingAgent
 from vc_gym.angles import wrap180
+from vc_gym.deprecation import renamed
 from vc_gym.envs.homing import LEARNED_CONFIRM_STOP_M
 from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
@@ -213,12 +213,7 @@ def canonical_homing_mode(mode: object) -> str:
     ValueError
         Naming the modes, for anything else.
     """
-    if isinstance(mode, str) and mode in DEPRECATED_HOMING_MODES:
-        new = DEPRECATED_HOMING_MODES[mode]
-        warnings.warn(
-            f"homing mode {mode!r} is deprecated; use {new!r}", DeprecationWarning, stacklevel=3
-        )
-        return new
+    mode = renamed("homing mode", mode, DEPRECATED_HOMING_MODES, stacklevel=3)
     if not isinstance(mode, str) or mode not in HOMING_MODES:
         raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
     return mode

@@ -7,11 +7,11 @@ the visual compass itself (``"visual_compass"``, its
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
 
 from vc_gym.compass import CompassConfig, ImageCompass, VisualCompass
+from vc_gym.deprecation import renamed
 from vc_gym.heading_sensors.feature import FeatureCompass
 from vc_gym.heading_sensors.image_difference import ImageDifferenceCompass
 from vc_gym.heading_sensors.magnetic import NoisyMagneticCompass
@@ -63,17 +63,9 @@ def current_sensor_name(name: Any, stacklevel: int = 2) -> Any:
     ``DeprecationWarning`` pointing ``stacklevel`` frames up, as
     :func:`warnings.warn`'s); anything else, or a deprecated name registered again, is
     returned as is."""
-    if not isinstance(name, str) or name in SENSORS:
+    if isinstance(name, str) and name in SENSORS:
         return name
-    new = DEPRECATED_SENSOR_NAMES.get(name)
-    if new is None:
-        return name
-    warnings.warn(
-        f"sensor name {name!r} is deprecated; use {new!r}",
-        DeprecationWarning,
-        stacklevel=stacklevel + 1,
-    )
-    return new
+    return renamed("sensor name", name, DEPRECATED_SENSOR_NAMES, stacklevel + 1)
 
 
 def register_sensor(name: str, factory: Callable[..., Any], overwrite: bool = False) -> None:

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.experiments.options import check_folder
 from vc_gym.jobs.backends import LocalBackend, RayBackend, make_backend
 from vc_gym.jobs.run import ExperimentRun
 from vc_gym.localization import make_tracker
@@ -66,8 +67,8 @@ class ExperimentOptions:
             raise ValueError(f"size must be one of {SIZES}, got {self.size!r}")
         if isinstance(self.video, bool) or not isinstance(self.video, int) or self.video < 0:
             raise ValueError(f"video must be an int >= 0, got {self.video!r}")
-        if self.atlas_dir is not None and not os.path.isdir(self.atlas_dir):
-            raise ValueError(f"--atlas {self.atlas_dir}: not a folder")
+        if self.atlas_dir is not None:
+            check_folder("--atlas", self.atlas_dir)
 
 
 def pick_size(table: Mapping[str, Mapping[str, Any]], size: str) -> dict[str, Any]:

@@ -20,14 +20,13 @@ environments experiment is the same in every registered scene.
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from vc_gym.deprecation import moved_names
+from vc_gym.deprecation import moved_names, renamed
 from vc_gym.experiments.studies import common, orientation_grid
 from vc_gym.experiments.studies.common import (
     ExperimentOptions,
@@ -184,14 +183,11 @@ DEPRECATED_VIEW_MODES = {"improved": "spot-grid"}
 
 def _check_modes(modes: Sequence[str] | None) -> list[str]:
     modes = ["paper"] if modes is None else modes
-    if not isinstance(modes, str) and any(m in DEPRECATED_VIEW_MODES for m in modes):
-        warnings.warn(
-            f"view modes {sorted(DEPRECATED_VIEW_MODES)} are deprecated; use "
-            f"{sorted(DEPRECATED_VIEW_MODES.values())}",
-            DeprecationWarning,
-            stacklevel=3,
-        )
-        modes = [DEPRECATED_VIEW_MODES.get(m, m) for m in modes]
+    if not isinstance(modes, str):
+        current = []
+        for m in modes:
+            current.append(renamed("view mode", m, DEPRECATED_VIEW_MODES, stacklevel=3))
+        modes = current
     known = list(orientation_grid.VIEW_MODES)
     if isinstance(modes, str) or not modes or len(set(modes)) != len(list(modes)):
         raise ValueError(f"modes must be distinct names from {known}, got {modes}")
