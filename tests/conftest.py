@@ -1,4 +1,5 @@
-"""Shared fixtures: seeded synthetic scenes and the optional real photo folder."""
+"""Shared fixtures: seeded synthetic scenes, the optional real photo folder, and a place
+cache of the test session's own."""
 
 from __future__ import annotations
 
@@ -13,6 +14,16 @@ from vc_gym.worlds.room import Room, make_room, render_room_view
 
 #: Yaws of the learning frames: 8 body directions x 3 head pans (paper 4.3).
 LEARN_YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]
+
+
+@pytest.fixture(scope="session", autouse=True)
+def place_cache_dir(tmp_path_factory):
+    """Learned places of this test session go to a temporary folder (``VC_GYM_CACHE``,
+    inherited by subprocesses), never to the user's cache."""
+    folder = tmp_path_factory.mktemp("vc_gym_cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("VC_GYM_CACHE", str(folder))
+        yield folder
 
 
 @pytest.fixture(scope="session")

@@ -137,9 +137,13 @@ def homing():
 
 
 def _wrapper(env: gym.Env, cls: type) -> gym.Env:
-    while not isinstance(env, cls):
-        env = env.env
-    return env
+    """The wrapper ``cls`` that Homing-v0 applies inside its env class."""
+    inner = {
+        PreviousAction: env.unwrapped.previous_action_wrapper,
+        StopAction: env.unwrapped.stop_action,
+    }[cls]
+    assert isinstance(inner, cls)
+    return inner
 
 
 @pytest.mark.parametrize("name", list(bad_actions(3)))

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 import vc_gym  # noqa: F401
-from vc_gym.envs.homing import HomingFeatures, StopAction
+from vc_gym.envs import LearnThenHomeEnv
+from vc_gym.envs.homing import HomingEnv, HomingFeatures, StopAction
 
 FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0}
 
 
-@pytest.mark.slow
 def test_spaces_and_wrapper_chain():
     env = gym.make("vc_gym/Homing-v0", **FAST)
     assert env.observation_space.shape == (12,) and env.action_space.shape == (3,)
@@ -22,7 +22,21 @@ def test_spaces_and_wrapper_chain():
     while w is not w.unwrapped:
         chain.append(type(w).__name__)
         w = w.env
-    assert {"StopAction", "HomingFeatures", "CompassObservation"} <= set(chain)
+    # one env class: gym.make's wrappers once each, the task's wrappers inside it
+    assert chain == ["TimeLimit", "OrderEnforcing", "PassiveEnvChecker"]
+    u = env.unwrapped
+    assert isinstance(u, HomingEnv) and isinstance(u, LearnThenHomeEnv)
+    assert u.observation_space == env.observation_space
+    assert u.action_space == env.action_space
+    assert isinstance(u.stop_action, StopAction) and isinstance(u.features, HomingFeatures)
+    assert u.stop_action.unwrapped is u and u.compass_observation.unwrapped is u
+    assert u.task_action_space.shape == (5,)
+    env.close()
+
+
+@pytest.mark.slow
+def test_a_reset_gives_a_feature_vector():
+    env = gym.make("vc_gym/Homing-v0", **FAST)
     obs, info = env.reset(seed=0)
     assert env.observation_space.contains(obs) and "pose" in info
     env.close()
@@ -66,9 +80,7 @@ def test_features_need_compass_observations():
 def test_stop_action_holds_still_until_the_task_stops():
     env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=1.0)
     assert env.action_space.shape == (3,)
-    stop_wrapper = env
-    while not isinstance(stop_wrapper, StopAction):
-        stop_wrapper = stop_wrapper.env
+    stop_wrapper = env.unwrapped.stop_action
     env.reset(seed=0, options={"pose": (0.1, 0.0, 0.0)})
     stop = np.array([0.0, 0.0, 1.0], np.float32)
     turn_and_stop = np.array([0.0, 1.0, 1.0], np.float32)
@@ -108,9 +120,7 @@ def test_only_the_stop_output_ends_an_episode(walk):
 @pytest.mark.slow
 def test_a_confirmed_stop_is_called_off_when_the_estimate_leaves_home():
     env = gym.make("vc_gym/Homing-v0", learn_time_s=0.2, stop_time_s=1.0, confirm_stop_m=0.25)
-    stop_wrapper = env
-    while not isinstance(stop_wrapper, StopAction):
-        stop_wrapper = stop_wrapper.env
+    stop_wrapper = env.unwrapped.stop_action
     stop_wrapper.min_walk_steps = 0
     stop = np.array([0.0, 0.0, 1.0], np.float32)
     # at home the estimate stays there: the stop holds and ends the episode
@@ -247,3 +257,54 @@ def test_previous_action_appends_the_last_action_taken():
         gym.make("vc_gym/Homing-v0", previous_action="yes", **FAST)
     with pytest.raises(ValueError, match="feature vector"):
         PreviousAction(gym.make("vc_gym/LearnThenHome-v0", **FAST))
+
+
+@pytest.mark.slow
+def test_the_env_class_steps_as_the_task_wrapped_by_hand():
+    # HomingEnv applies the wrappers inside itself; its episodes are those of the task
+    # wrapped by hand (what vc_gym/Homing-v0 was built as, what trained policies saw)
+    from vc_gym.envs import CompassObservation, PreviousAction
+
+    kwargs = {**FAST, "stop_time_s": 1.0, "min_walk_s": 0.5}
+    made = gym.make("vc_gym/Homing-v0", previous_action=True, confirm_stop_m=0.25, **kwargs)
+    task = LearnThenHomeEnv(learn_time_s=0.2, max_homing_s=3.0, stop_time_s=1.0, place_cache=False)
+    by_hand = PreviousAction(
+        StopAction(
+            HomingFeatures(CompassObservation(task, keep_image=False)),
+            min_walk_s=0.5,
+            confirm_stop_m=0.25,
+        )
+    )
+    rng = np.random.default_rng(7)
+    for seed in (3, 4):
+        a, info_a = made.reset(seed=seed)
+        b, info_b = by_hand.reset(seed=seed)
+        np.testing.assert_array_equal(a, b)
+        for i in range(40):
+            action = rng.uniform(-1, 1, 3).astype(np.float32)
+            action[2] = 1.0 if i % 9 == 8 else action[2]
+            a, ra, ta, ua, info_a = made.step(action)
+            b, rb, tb, ub, info_b = by_hand.step(action)
+            np.testing.assert_array_equal(a, b)
+            assert (ra, ta, ua) == (rb, tb, ub) and info_a.keys() == info_b.keys()
+            np.testing.assert_array_equal(info_a["pose"], info_b["pose"])
+            if ta or ua:
+                break
+    made.close()
+    by_hand.close()
+
+
+def test_the_inner_wrappers_settings_are_read_and_set_through_the_env():
+    env = gym.make("vc_gym/Homing-v0", min_walk_m=0.3, confirm_stop_m=0.25, **FAST)
+    u = env.unwrapped
+    assert env.get_wrapper_attr("min_walk_m") == 0.3 == u.stop_action.min_walk_m
+    assert env.get_wrapper_attr("confirm_stop_m") == 0.25
+    assert env.get_wrapper_attr("n_spots") == 4 and env.get_wrapper_attr("max_forward") == 0.4
+    env.set_wrapper_attr("min_walk_m", 0.5)
+    assert u.stop_action.min_walk_m == 0.5
+    env.set_wrapper_attr("home_offset_m", (0.1, 0.0))
+    assert u.features.home_offset_m == (0.1, 0.0)
+    assert not hasattr(u, "env")  # the env is no wrapper
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        u.nothing  # noqa: B018
+    env.close()

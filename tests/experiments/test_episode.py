@@ -82,8 +82,7 @@ def test_a_learned_agent_runs_with_its_stops_checked():
     from vc_gym.experiments.episode import LEARNED_CONFIRM_STOP_M
 
     run = make_homing_run(agent=str(PRETRAINED_MODEL), learn_time_s=0.2, max_homing_s=3.0)
-    wrapper = run.env
-    while not isinstance(wrapper, StopAction):
-        wrapper = wrapper.env
+    wrapper = run.env.unwrapped.stop_action  # Homing-v0 applies it inside its env class
+    assert isinstance(wrapper, StopAction)
     assert wrapper.confirm_stop_m == LEARNED_CONFIRM_STOP_M == 0.25
     run.env.close()

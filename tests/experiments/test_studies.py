@@ -53,8 +53,17 @@ def test_every_experiment_wrote_its_files(paper_quick, name):
 def test_every_experiment_is_tested_end_to_end():
     # the paper report runs ORDER; the others have end-to-end tests of their own (agents:
     # tests/training/test_training.py, it needs a trained model; real-rotation and
-    # synthetic-compass: tests/test_cli.py)
-    expected = {*ORDER, "paper", "localization", "agents", "real-rotation", "synthetic-compass"}
+    # synthetic-compass: tests/test_cli.py; calibration:
+    # tests/experiments/studies/test_calibration.py)
+    expected = {
+        *ORDER,
+        "paper",
+        "localization",
+        "agents",
+        "real-rotation",
+        "synthetic-compass",
+        "calibration",
+    }
     assert set(EXPERIMENTS) == expected
 
 

@@ -22,7 +22,17 @@ __all__ = ["COMMANDS", "EXIT_INTERRUPTED", "build_parser", "main"]
 #: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
 EXIT_INTERRUPTED = 130
 #: The command modules of :mod:`vc_gym.cli`, in the order ``vc-gym --help`` lists them.
-COMMANDS = ("demo", "bench", "evaluate", "train", "render", "soak", "check", "experiment")
+COMMANDS = (
+    "demo",
+    "bench",
+    "evaluate",
+    "train",
+    "render",
+    "soak",
+    "check",
+    "experiment",
+    "compass",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -65,6 +75,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args, unknown = parser.parse_known_args(argv)
         if unknown:
             getattr(args, "parser", parser).error(f"unrecognized arguments: {' '.join(unknown)}")
+        # the command line as typed, for the pages that say how their figures were made
+        args.argv = list(sys.argv[1:] if argv is None else argv)
         return int(args.func(args))
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
         hint = args.hint(args) if getattr(args, "hint", None) else ""

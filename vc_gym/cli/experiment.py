@@ -10,12 +10,14 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import shlex
 import sys
 import textwrap
 from pathlib import Path
 from typing import Any
 
 from vc_gym.cli.arguments import add_json_option, add_option
+from vc_gym.experiments.results_page import PageInfo, check_page_path, seeds_text, write_page
 from vc_gym.experiments.studies import EXPERIMENTS, SIZES, Experiment
 from vc_gym.validation import check_seed
 
@@ -78,6 +80,12 @@ def _add_experiment_parser(names: argparse._SubParsersAction, e: Experiment) -> 
         )
     for option in e.options:
         add_option(p, option)
+    p.add_argument(
+        "--page",
+        metavar="FILE.md",
+        help="also write the results page of the docs (e.g. docs/results/"
+        f"{e.name}.md): command, version and commit, date, machine, seeds, figures, plots",
+    )
     add_json_option(p)
     p.set_defaults(func=run, hint=resume_hint)
 
@@ -105,6 +113,8 @@ def run(args: argparse.Namespace) -> int:
         workers=getattr(args, "workers", None),
         address=getattr(args, "address", None),
         json_output=args.json,
+        page=args.page,
+        command_line="vc-gym " + shlex.join(getattr(args, "argv", [])),
     )
 
 
@@ -120,12 +130,16 @@ def run_experiment(
     workers: int | None = None,
     address: str | None = None,
     json_output: bool = False,
+    page: str | None = None,
+    command_line: str = "",
 ) -> int:
     """Check every argument, run experiment ``e`` in ``out`` and print what it found.
 
     ``options`` maps the parameters of ``e``'s declared options to their values (those
     marked ``to_options`` go to :class:`ExperimentOptions`, the rest to the runner).
-    Returns the exit status: 1 if jobs failed, else 0.
+    With ``page``, also writes that results page
+    (:func:`~vc_gym.experiments.results_page.write_page`; ``command_line`` is the
+    command it names). Returns the exit status: 1 if jobs failed, else 0.
     """
     from vc_gym.experiments.studies import ExperimentOptions
     from vc_gym.jobs.backends import make_backend
@@ -135,6 +149,8 @@ def run_experiment(
     # every flag's bounds before the folder is made and any worker starts; the
     # experiment checks its settings again (and what only it knows) before its first job
     check_seed("--seed", seed)
+    if page is not None:
+        check_page_path(page)
     if workers is not None:
         check_workers(workers, "--workers")
     declared = {o.parameter: o for o in e.options}
@@ -160,6 +176,21 @@ def run_experiment(
             print(line)
         print(_written(folder))
     failed = results.get("failed_jobs") or []
+    if page is not None and not failed:
+        written = write_page(
+            page,
+            PageInfo(
+                title=f"`vc-gym experiment {e.name}`",
+                command=command_line or f"vc-gym experiment {e.name} --page {page}",
+                description=e.help,
+                seeds=seeds_text(results, seed),
+            ),
+            e.summary_lines(results),
+            {k: v for k, v in results.items() if k != "per_episode"},
+            sorted(folder.glob("*.png")),
+        )
+        if not json_output:
+            print(f"wrote the results page {written}")
     if failed:
         print(
             f"vc-gym {command}: failed: {len(failed)} job(s) failed twice, e.g. "

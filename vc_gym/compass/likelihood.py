@@ -10,7 +10,8 @@ Pure numpy functions on arrays; :class:`~vc_gym.compass.VisualCompass` and
   heading, under one map or several that share a config and colour classes;
 - :func:`remapped_log_likelihoods`: the same with each view sector scored against
   another map sector (parallax);
-- :func:`heading_estimates`: best heading, spread (eq. 27) and goodness (eq. 28).
+- :func:`heading_estimates`: best heading, spread (eq. 27, calibrated by a temperature:
+  :mod:`~vc_gym.compass.calibration`) and goodness (eq. 28).
 
 The log-likelihood is the log of the likelihood *ratio* against the map's
 heading-independent model (its histograms pooled over all sectors): it differs from
@@ -25,6 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from vc_gym.angles import circular_std_rows, peak_headings
+from vc_gym.compass.calibration import UNCALIBRATED, tempered_spreads
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.features import (
     NOISE_CHANGE_RATIO,
@@ -228,6 +230,7 @@ def heading_estimates(
     counts: np.ndarray,
     total: np.ndarray,
     lls: np.ndarray,
+    spread_calibrations: Sequence[tuple[float, float]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, list[float], list[int]]:
     """Best heading, spread and goodness of one frame under each of ``M`` maps.
 
@@ -243,6 +246,9 @@ def heading_estimates(
         The frame's scan geometry and :func:`sector_features`.
     lls : numpy.ndarray
         ``(M, n_headings)`` log-likelihoods (:func:`log_likelihoods`).
+    spread_calibrations : sequence of (float, float), optional
+        Each map's ``(temperature, floor_deg)`` (:mod:`~vc_gym.compass.calibration`);
+        default :data:`~vc_gym.compass.calibration.UNCALIBRATED` for every map.
 
     Returns
     -------
@@ -251,7 +257,10 @@ def heading_estimates(
         neighbours.
     spread : numpy.ndarray
         ``(M,)`` the circular standard deviation (eq. 27) of the posterior
-        ``∝ exp(log-likelihood)``.
+        ``∝ exp(log-likelihood / temperature)``, at least ``floor_deg``; uncalibrated
+        (temperature 1, no floor) the paper's. Infinite for a frame without evidence
+        (no sector contributed): its posterior is uniform, whose mean resultant length
+        is 0 and ``sqrt(-2 ln 0)`` infinite.
     scores : list of float
         The mean per-term log-probability at the best heading (eq. 28).
     n_sectors : list of int
@@ -259,8 +268,16 @@ def heading_estimates(
     """
     m = lls.shape[0]
     heading, best = peak_headings(lls, config.heading_step_deg)
-    spread = circular_std_rows(headings, np.exp(lls - lls[np.arange(m), best][:, None]))
+    cal = [UNCALIBRATED] * m if spread_calibrations is None else list(spread_calibrations)
+    if len(cal) != m:
+        raise ValueError(f"need one spread calibration per map ({m}), got {len(cal)}")
+    if all(c == UNCALIBRATED for c in cal):
+        spread = circular_std_rows(headings, np.exp(lls - lls[np.arange(m), best][:, None]))
+    else:
+        t, floor = (np.array(v, dtype=np.float64) for v in zip(*cal, strict=True))
+        spread = tempered_spreads(lls, headings, t, floor)
     scores, n_sectors = _scores_at(config, log_abs, geom, counts, total, best)
+    spread[np.asarray(n_sectors) == 0] = np.inf
     return heading, spread, scores, n_sectors
 
 

@@ -1,13 +1,23 @@
 """A compass map as plain arrays and ``.npz`` files (design: Persistence).
 
 A map file holds the config that produced it, the colour classes, the counts (eq. 6),
-how many frames saw each sector, the exposure reference level, the frame sizes learned
-and, with ``exposure="map"``, the light per sector. It is written atomically and read
+how many frames saw each sector, the exposure reference level, the frame sizes learned,
+the calibration of the heading spread (:mod:`~vc_gym.compass.calibration`) and, with
+``exposure="map"``, the light per sector. It is written atomically and read
 with :func:`vc_gym.persistence.load_npz_checked` (never unpickled); every entry is
 checked against the stored config, and a file that cannot be read gives a
 :class:`~vc_gym.errors.MapFileError` naming the file and the entry at fault.
 :class:`~vc_gym.compass.CompassAtlas` stores several maps in one file through the same
 arrays (with shared colour classes written once).
+
+Schema version 1. The spread calibration (entry ``spread_calibration``:
+``[temperature, floor_deg]``) is optional within it, so the version stays: a file
+without the entry loads as uncalibrated
+(:data:`~vc_gym.compass.calibration.UNCALIBRATED`: the paper's spread), and a reader
+that does not know the entry ignores it; an entry of another shape or with a value out
+of range is refused. It is one entry, not two, so that an atlas of
+:data:`~vc_gym.compass.atlas.MAX_SPOTS` spots with their own colour classes and light
+maps stays within :data:`~vc_gym.persistence.MAX_MEMBERS` entries.
 """
 
 from __future__ import annotations
@@ -19,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vc_gym.compass.calibration import UNCALIBRATED, check_spread_calibration
 from vc_gym.compass.colors import MAX_LIGHT_LEVEL, ColorClasses
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.light_gain import REFERENCE_EXPOSURES
@@ -37,6 +48,7 @@ __all__ = [
     "read_light_map",
     "read_map_contents",
     "read_map_file",
+    "read_spread_calibration",
     "write_map_file",
 ]
 
@@ -68,6 +80,9 @@ class MapContents:
     light : LightMap or None
         The light per sector; written and read only with ``exposure="map"``
         (``None`` when read from a map of another mode).
+    spread_calibration : tuple of float
+        ``(temperature, floor_deg)`` of the heading spread
+        (:mod:`~vc_gym.compass.calibration`); uncalibrated by default.
     """
 
     counts: np.ndarray
@@ -76,6 +91,7 @@ class MapContents:
     exposure_reference: float
     learned_sizes: set[tuple[int, int]]
     light: LightMap | None
+    spread_calibration: tuple[float, float] = UNCALIBRATED
 
 
 def check_learned_sizes(sizes: set[tuple[int, int]]) -> None:
@@ -102,6 +118,7 @@ def map_arrays(
         "frames_learned": np.array(contents.frames_learned, dtype=np.int64),
         "exposure_reference": np.array(contents.exposure_reference, dtype=np.float64),
         "learned_sizes": np.array(sorted(contents.learned_sizes), dtype=np.int64).reshape(-1, 2),
+        "spread_calibration": np.array(contents.spread_calibration, dtype=np.float64),
     }
     if config.exposure == "map":
         assert contents.light is not None
@@ -238,7 +255,35 @@ def read_map_contents(
         exposure_reference=float(ref),
         learned_sizes={(int(a), int(b)) for a, b in sizes},
         light=light,
+        spread_calibration=read_spread_calibration(arrays, path),
     )
+
+
+def read_spread_calibration(
+    arrays: Mapping[str, np.ndarray], source: object
+) -> tuple[float, float]:
+    """``(temperature, floor_deg)`` of a map file's ``spread_calibration`` entry;
+    :data:`~vc_gym.compass.calibration.UNCALIBRATED` when it is absent (a map never
+    calibrated, or written by a vc_gym without calibration).
+
+    Raises
+    ------
+    MapFileError
+        Naming ``source``: an entry that is not two real numbers, or values
+        :func:`~vc_gym.compass.calibration.check_spread_calibration` refuses.
+    """
+    a = arrays.get("spread_calibration")
+    if a is None:
+        return UNCALIBRATED
+    if a.shape != (2,) or a.dtype.kind not in "iuf":
+        raise MapFileError(
+            f"{source}: entry 'spread_calibration' must be two real numbers "
+            f"[temperature, floor_deg], got {a.dtype} of shape {a.shape}"
+        )
+    try:
+        return check_spread_calibration(float(a[0]), float(a[1]))
+    except ValueError as e:
+        raise MapFileError(f"{source}: invalid spread calibration ({e})") from None
 
 
 def read_light_map(arrays: Mapping[str, np.ndarray], source: object, n_sectors: int) -> LightMap:

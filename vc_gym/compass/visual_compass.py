@@ -8,7 +8,8 @@ The class holds the map and checks its inputs; the work is done by one module pe
 concept: :mod:`~vc_gym.compass.scan_geometry` (which columns fall into which
 sector), :mod:`~vc_gym.compass.sector_map` (how frames add to the map),
 :mod:`~vc_gym.compass.likelihood` (features, log tables, log-likelihoods,
-estimates), :mod:`~vc_gym.compass.light_gain` (the exposure correction) and
+estimates), :mod:`~vc_gym.compass.calibration` (the temperature that calibrates the
+heading spread), :mod:`~vc_gym.compass.light_gain` (the exposure correction) and
 :mod:`~vc_gym.compass.map_files` (arrays and ``.npz`` files).
 """
 
@@ -21,6 +22,17 @@ from pathlib import Path
 
 import numpy as np
 
+from vc_gym.compass.calibration import (
+    FLOOR_STEPS,
+    MIN_CALIBRATION_FRAMES,
+    MIN_COVERED_FRACTION,
+    UNCALIBRATED,
+    SpreadCalibration,
+    calibration_report,
+    check_spread_calibration,
+    fit_temperature,
+    heading_errors,
+)
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import CompassConfig
@@ -78,10 +90,18 @@ class CompassEstimate:
         Most likely heading in ``[0, 360)`` (arg-max of the log-likelihood, refined
         between grid points by a parabola through the peak and its neighbours).
     spread_deg : float
-        Circular standard deviation (eq. 27) of the posterior ``∝ exp(log-likelihood)``
-        under a uniform prior. Small when one heading clearly wins, large when the image
-        is ambiguous: about 500° for a flat posterior (the resultant length of a uniform
-        posterior is zero only up to rounding), infinite for an exactly uniform one.
+        Circular standard deviation ``sqrt(-2 ln R)`` (eq. 27) of the posterior
+        ``∝ exp(log-likelihood / T)`` under a uniform prior, at least a floor, with the
+        temperature ``T`` and the floor of the map's spread calibration
+        (:attr:`VisualCompass.spread_temperature`, :meth:`VisualCompass.calibrate`;
+        :mod:`~vc_gym.compass.calibration`). Calibrated, the true heading lies within
+        ``±2 spread_deg`` of ``heading_deg`` for about 95 % of frames taken at the
+        learning spot; uncalibrated (``T = 1``, no floor: the paper's eq. 16 as a
+        product of independent terms) it is far too small. Small when one heading
+        clearly wins, large when the image is ambiguous (a nearly flat posterior gives
+        hundreds of degrees). ``inf`` exactly when :attr:`has_evidence` is false: the
+        posterior is then uniform, its resultant length ``R`` is 0 and
+        ``sqrt(-2 ln 0)`` infinite (a Kalman filter given it does not update).
     score : float
         Goodness of fit: the mean log-probability per term (sector × class pair) of
         the image's features under the map at the best heading, ``<= 0``. It is
@@ -91,7 +111,8 @@ class CompassEstimate:
     n_sectors : int
         Number of sectors the image contributed (about ``hfov / sector_deg``); ``0``
         when it shows no usable colour change, and then :attr:`has_evidence` is false,
-        ``heading_deg`` is ``0.0`` and the spread is that of a flat posterior.
+        ``heading_deg`` is ``0.0``, ``spread_deg`` is ``inf`` and the log-likelihood is
+        flat (all zeros).
     log_likelihood : numpy.ndarray
         The full log-likelihood over :attr:`VisualCompass.headings_deg`.
     """
@@ -147,6 +168,7 @@ class VisualCompass:
     >>> vc.fit_colors(images)                                   # doctest: +SKIP
     >>> for img, yaw in training: vc.learn(img, Camera(yaw_deg=yaw))  # doctest: +SKIP
     >>> vc.estimate(new_image, Camera()).heading_deg            # doctest: +SKIP
+    >>> vc.calibrate(images, cameras, leave_one_out=True)       # doctest: +SKIP
     """
 
     def __init__(self, config: CompassConfig | None = None, colors: ColorClasses | None = None):
@@ -165,6 +187,7 @@ class VisualCompass:
         self._frames = 0
         self._sizes: set[tuple[int, int]] = set()  # (H, W) of the learned frames
         self._tables: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._spread = UNCALIBRATED  # (temperature, floor_deg) of the heading spread
         h = np.arange(cfg.n_headings, dtype=np.float64) * cfg.heading_step_deg
         h.setflags(write=False)
         self._headings = h
@@ -200,6 +223,41 @@ class VisualCompass:
     def is_learned(self) -> bool:
         """True once colour classes exist and at least one frame was learned."""
         return self._colors is not None and self._frames > 0
+
+    @property
+    def spread_temperature(self) -> float:
+        """Temperature ``T`` of the heading spread: :attr:`CompassEstimate.spread_deg` is
+        the eq. 27 spread of ``exp(log-likelihood / T)``, floored at
+        :attr:`spread_floor_deg` (:mod:`~vc_gym.compass.calibration`). 1 until
+        :meth:`calibrate` or :meth:`set_spread_temperature`. It changes the spread only:
+        :meth:`log_likelihood` and the heading are the same for every ``T``."""
+        return self._spread[0]
+
+    @property
+    def spread_floor_deg(self) -> float:
+        """Smallest :attr:`CompassEstimate.spread_deg` of a frame with evidence (degrees;
+        0 until calibrated, half a heading step once calibrated)."""
+        return self._spread[1]
+
+    @property
+    def is_spread_calibrated(self) -> bool:
+        """Whether the spread has a calibration (fitted or set by hand)."""
+        return self._spread != UNCALIBRATED
+
+    def set_spread_temperature(self, temperature: float, floor_deg: float | None = None) -> None:
+        """Set the spread's temperature by hand (and its floor: by default half a
+        heading step, :data:`~vc_gym.compass.calibration.FLOOR_STEPS`).
+
+        ``set_spread_temperature(1.0, 0.0)`` restores the uncalibrated (paper's) spread.
+
+        Raises
+        ------
+        ValueError
+            A temperature outside ``[0.01, 1000]`` or a floor outside ``[0, 90]`` degrees.
+        """
+        if floor_deg is None:
+            floor_deg = FLOOR_STEPS * self.config.heading_step_deg
+        self._spread = check_spread_calibration(temperature, floor_deg)
 
     # ------------------------------------------------------------------ colours
     def _set_colors(self, colors: ColorClasses) -> None:
@@ -282,7 +340,9 @@ class VisualCompass:
         return self
 
     def reset_map(self) -> None:
-        """Forget every learned frame (keeps the colour classes)."""
+        """Forget every learned frame and the spread calibration (keeps the colour
+        classes)."""
+        self._spread = UNCALIBRATED
         self._counts[:] = 0
         self._n_obs[:] = 0
         self._light.clear()
@@ -326,7 +386,9 @@ class VisualCompass:
         """Add one frame seen at the known ``camera.yaw_deg`` to the map (eq. 6).
 
         Only the sectors in the camera's view are updated: each gets one count in
-        the bin its relative frequency (eq. 11) falls in, for every class pair.
+        the bin its relative frequency (eq. 11) falls in, for every class pair. The spread
+        calibration is left as it is: once the turn is learned,
+        ``calibrate(images, cameras, leave_one_out=True)`` fits it to the learning frames.
 
         Returns
         -------
@@ -343,6 +405,23 @@ class VisualCompass:
         self._checked(image, camera, need_map=False)
         h, w = image.shape[:2]
         check_learned_sizes(self._sizes | {(h, w)})
+        pixels, colcounts, sector = self._frame_columns(image, camera)
+        seen = add_frame(self._counts, self._n_obs, colcounts, sector)
+        if seen.size == 0:
+            return 0
+        if self.config.exposure == "map":
+            self._light.add(sector, column_levels(pixels))
+        self._frames += 1
+        self._sizes.add((h, w))
+        self._tables = None
+        return int(seen.size)
+
+    def _frame_columns(
+        self, image: np.ndarray, camera: Camera
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What :meth:`learn` adds of a frame: its scanned pixels, the transition counts
+        of each scanned column and the map sector each column looks into."""
+        h, w = image.shape[:2]
         geom = self._geometry(camera, w, h)
         pixels = image[geom.row_slice, geom.col_slice]
         colcounts = self._column_counts(self._scanned_classes(pixels))
@@ -350,15 +429,134 @@ class VisualCompass:
         sector = column_sectors(
             camera.yaw_deg, geom.grid.offsets_deg, cfg.sector_deg, cfg.n_sectors
         )
-        seen = add_frame(self._counts, self._n_obs, colcounts, sector)
+        return pixels, colcounts, sector
+
+    def _without_frame(self, image: np.ndarray, camera: Camera) -> VisualCompass | None:
+        """A copy of this compass whose map lacks one learned frame (eq. 6 is a sum, so
+        its counts are subtracted), or ``None`` if the frame adds nothing or the rest of
+        the map saw fewer than :data:`~vc_gym.compass.calibration.MIN_COVERED_FRACTION`
+        of its sectors.
+
+        Raises
+        ------
+        ValueError
+            If the map does not hold the frame (removing it leaves negative counts).
+        """
+        pixels, colcounts, sector = self._frame_columns(image, camera)
+        counts = np.zeros_like(self._counts)
+        n_obs = np.zeros_like(self._n_obs)
+        seen = add_frame(counts, n_obs, colcounts, sector)
         if seen.size == 0:
-            return 0
-        if cfg.exposure == "map":
-            self._light.add(sector, column_levels(pixels))
-        self._frames += 1
-        self._sizes.add((h, w))
-        self._tables = None
-        return int(seen.size)
+            return None
+        counts = self._counts - counts
+        n_obs = self._n_obs - n_obs
+        if np.any(counts < 0) or np.any(n_obs < 0):
+            raise ValueError(
+                f"the map does not hold the frame at yaw {camera.yaw_deg:g}°: leave_one_out "
+                "needs frames this compass learned, with the cameras they were learned with"
+            )
+        if np.mean(n_obs[seen] > 0) < MIN_COVERED_FRACTION:
+            return None
+        out = self._empty_copy()
+        out._counts, out._n_obs = counts, n_obs
+        out._frames = self._frames - 1
+        if self.config.exposure == "map":
+            out._light.merge(self._light)
+            mine = LightMap(self.config.n_sectors)
+            mine.add(sector, column_levels(pixels))
+            out._light.level_sum = np.maximum(out._light.level_sum - mine.level_sum, 0.0)
+            out._light.columns = np.maximum(out._light.columns - mine.columns, 0.0)
+        return out
+
+    def calibrate(
+        self,
+        images: Sequence[np.ndarray],
+        cameras: Sequence[Camera],
+        *,
+        leave_one_out: bool = False,
+        floor_deg: float | None = None,
+        gain: float | None = None,
+    ) -> SpreadCalibration:
+        """Fit the temperature of the heading spread to frames whose heading is known.
+
+        Each frame is estimated (its camera's ``yaw_deg`` is the truth), and the
+        temperature ``T`` is the one whose spreads best describe the errors (the
+        Gaussian score of :func:`~vc_gym.compass.calibration.fit_temperature`), so that
+        about 68 % and 95 % of true headings lie within one and two
+        :attr:`CompassEstimate.spread_deg` of the estimate. ``T`` and the floor are
+        kept (:attr:`spread_temperature`, saved with the map); the heading and the
+        log-likelihood do not change.
+
+        Parameters
+        ----------
+        images : sequence of numpy.ndarray
+            ``(H, W, 3)`` uint8 RGB frames.
+        cameras : sequence of Camera
+            One per image, its ``yaw_deg`` the frame's true heading.
+        leave_one_out : bool
+            The frames are ones this map learned (a learning turn, with the cameras
+            :meth:`learn` was given): each is estimated against the map without itself,
+            a new view from the learning spot. Frames whose sectors the rest of the map
+            mostly did not see (learning frames that do not overlap) are skipped. Without
+            it the frames must be new to the map (learned frames would be estimated
+            against themselves: far too small errors).
+        floor_deg : float, optional
+            Floor of the spread; default half a heading step
+            (:data:`~vc_gym.compass.calibration.FLOOR_STEPS`).
+        gain : float, optional
+            As for :meth:`log_likelihood` (the session's light).
+
+        Returns
+        -------
+        SpreadCalibration
+            The temperature, the frames used and skipped, and the share of errors
+            within one and two spreads on those frames.
+
+        Raises
+        ------
+        ValueError
+            Images and cameras of different lengths or invalid, a frame the map does
+            not hold (``leave_one_out``), or fewer than
+            :data:`~vc_gym.compass.calibration.MIN_CALIBRATION_FRAMES` frames usable.
+        NotLearnedError
+            If the map is empty.
+        """
+        if isinstance(images, np.ndarray) and images.ndim == 3:
+            images = [images]
+        if isinstance(cameras, Camera):
+            cameras = [cameras]
+        images, cameras = list(images), list(cameras)
+        if len(images) != len(cameras):
+            raise ValueError(f"got {len(images)} images but {len(cameras)} cameras")
+        floor = FLOOR_STEPS * self.config.heading_step_deg if floor_deg is None else floor_deg
+        _, floor = check_spread_calibration(1.0, floor)
+        for image, camera in zip(images, cameras, strict=True):
+            self._checked(image, camera, need_map=True)
+        lls, truth, skipped = [], [], 0
+        for image, camera in zip(images, cameras, strict=True):
+            vc = self._without_frame(image, camera) if leave_one_out else self
+            est = None if vc is None else vc.estimate(image, camera, gain=gain)
+            if est is None or not est.has_evidence:
+                skipped += 1
+                continue
+            lls.append(est.log_likelihood)
+            truth.append(camera.yaw_deg)
+        if len(lls) < MIN_CALIBRATION_FRAMES:
+            why = (
+                " (leave-one-out skips learning frames whose view no other learning frame "
+                "saw: calibrate with held-out frames of known heading instead)"
+                if leave_one_out
+                else ""
+            )
+            raise ValueError(
+                f"calibration needs at least {MIN_CALIBRATION_FRAMES} frames with evidence, "
+                f"got {len(lls)} of {len(images)}{why}"
+            )
+        ll = np.array(lls)
+        errors = heading_errors(ll, np.array(truth), self.config.heading_step_deg)
+        temperature = fit_temperature(ll, errors, self._headings, floor)
+        self._spread = (temperature, floor)
+        return calibration_report(ll, errors, self._headings, temperature, floor, skipped)
 
     def merge(self, other: VisualCompass) -> VisualCompass:
         """Add the map of ``other`` to this one (in place; returns ``self``).
@@ -366,7 +564,9 @@ class VisualCompass:
         A map is counts (eq. 6), so the map learned from two sets of frames is the sum of
         their maps: merging the turns learned at several places near a spot gives the map
         of all their frames. Both compasses must share the config and the colour classes
-        (learn the second with the first's :attr:`colors`).
+        (learn the second with the first's :attr:`colors`). This compass keeps its spread
+        calibration, fitted to the map before the merge: :meth:`calibrate` again for the
+        merged one.
 
         Raises
         ------
@@ -443,9 +643,11 @@ class VisualCompass:
 
     def _empty_copy(self) -> VisualCompass:
         """A compass with an empty map and this one's config, colours, exposure
-        reference, frame count and frame sizes (the map is filled in by the caller)."""
+        reference, spread calibration, frame count and frame sizes (the map is filled in
+        by the caller)."""
         out = VisualCompass(self.config, self._colors)
         out._exposure_ref = self._exposure_ref
+        out._spread = self._spread
         out._frames = self._frames
         out._sizes = set(self._sizes)
         return out
@@ -702,6 +904,7 @@ class VisualCompass:
             exposure_reference=self._exposure_ref,
             learned_sizes=self._sizes,
             light=self._light,
+            spread_calibration=self._spread,
         )
         return map_arrays(self.config, contents, self._colors if with_colors else None)
 
@@ -761,6 +964,7 @@ class VisualCompass:
         vc._n_obs[:] = contents.sector_observations
         vc._frames = contents.frames_learned
         vc._sizes = contents.learned_sizes
+        vc._spread = contents.spread_calibration
         return vc
 
     def __repr__(self) -> str:
@@ -786,7 +990,14 @@ def _estimates_of(
     first = compasses[0]
     log_abs = [vc._log_tables()[2] for vc in compasses]
     heading, spread, scores, n_sectors = heading_estimates(
-        first.config, first._headings, log_abs, geom, counts, total, lls
+        first.config,
+        first._headings,
+        log_abs,
+        geom,
+        counts,
+        total,
+        lls,
+        [vc._spread for vc in compasses],
     )
     return [
         CompassEstimate(float(heading[k]), float(spread[k]), scores[k], n_sectors[k], lls[k])

@@ -9,21 +9,17 @@ file instead (:class:`SavedAtlas`), or learn it once and write it for the others
 
 from __future__ import annotations
 
-import contextlib
+import hashlib
 import json
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from vc_gym.compass import CompassAtlas
 from vc_gym.envs.learning import Learner, LearningConfig, LearningResult
+from vc_gym.envs.place_cache import default_cache_dir, file_lock
 from vc_gym.errors import MapFileError
-
-try:  # POSIX: workers that share a file wait for the first one to learn it
-    import fcntl
-except ImportError:  # pragma: no cover - Windows: each worker may learn it once
-    fcntl = None
 
 __all__ = ["AtlasFile", "SavedAtlas"]
 
@@ -66,8 +62,11 @@ class AtlasFile:
     The file's metadata holds ``spec`` (everything that shapes the learning: scene,
     learning settings, learner, seed, room options); a file learned with another spec
     is refused with a :class:`~vc_gym.errors.MapFileError` rather than silently used.
-    Processes that share ``path`` take a lock beside it (``path + ".lock"``, POSIX), so
-    one learns while the others wait and then load.
+    Processes that share ``path`` take a lock (POSIX), so one learns while the others
+    wait and then load. The lock file lies in the place cache's folder
+    (:func:`~vc_gym.envs.place_cache.default_cache_dir`, ``locks/``, named by the
+    hash of ``path``'s absolute form), so that a run leaves nothing but the atlas in
+    the folder of ``path`` (often the working folder).
 
     Parameters
     ----------
@@ -103,20 +102,14 @@ class AtlasFile:
             )
         return _result_of(atlas, meta)
 
-    @contextlib.contextmanager
-    def _locked(self) -> Iterator[None]:
-        if fcntl is None:  # pragma: no cover
-            yield
-            return
-        with open(self.path.with_name(self.path.name + ".lock"), "a") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)
-            try:
-                yield
-            finally:
-                fcntl.flock(lock, fcntl.LOCK_UN)
+    @property
+    def lock_path(self) -> Path:
+        """The lock file of ``path``: in the place cache's folder, never beside ``path``."""
+        name = hashlib.sha256(str(self.path.resolve()).encode()).hexdigest()[:32]
+        return default_cache_dir() / "locks" / f"{name}.npz.lock"
 
     def __call__(self, room, config: LearningConfig) -> LearningResult:
-        with self._locked():
+        with file_lock(self.lock_path):
             if self.path.exists():
                 self.learned = False
                 return self._load()

@@ -1,10 +1,12 @@
 """``vc_gym/Homing-v0``: the homing task as a learned agent sees it.
 
-``vc_gym/LearnThenHome-v0`` → :class:`~vc_gym.envs.CompassObservation` (image
-dropped, any tracker) → :class:`HomingFeatures` (one scaled feature vector) →
-:class:`StopAction` (walk, turn, stop). ``gym.make("vc_gym/Homing-v0", **kwargs)``,
-``gym.make_vec`` and stable-baselines3's ``make_vec_env`` all build exactly what
-``vc-gym train`` trains on.
+:class:`HomingEnv` is ``vc_gym/LearnThenHome-v0`` seen through
+:class:`~vc_gym.envs.CompassObservation` (image dropped, any tracker) →
+:class:`HomingFeatures` (one scaled feature vector) → :class:`StopAction` (walk, turn,
+stop) [→ :class:`PreviousAction`]: one env class, whose ``unwrapped`` is itself, with
+the feature vector and the three actions as its spaces. ``gym.make("vc_gym/Homing-v0",
+**kwargs)``, ``gym.make_vec`` and stable-baselines3's ``make_vec_env`` all build exactly
+what ``vc-gym train`` trains on.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from vc_gym.envs.learn_then_home import LearnThenHomeEnv
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
@@ -31,6 +34,7 @@ __all__ = [
     "LEARNED_CONFIRM_STOP_M",
     "MAX_HOME_OFFSET_M",
     "STOP_THRESHOLD",
+    "HomingEnv",
     "HomingFeatures",
     "PreviousAction",
     "StopAction",
@@ -322,19 +326,79 @@ class PreviousAction(gym.Wrapper):
         return np.concatenate([obs, action]).astype(np.float32)
 
 
-def make_homing_env(
-    tracker: TrackerSpec = "grid",
-    max_forward: float = 0.4,
-    max_turn_deg_s: float = 60.0,
-    min_walk_s: float = 2.0,
-    confirm_stop_m: float | None = None,
-    head_scan: bool = True,
-    min_walk_m: float = 0.0,
-    home_offset_m: Any = (0.0, 0.0),
-    previous_action: bool = False,
-    **task_kwargs: Any,
-) -> gym.Env:
-    """Build ``vc_gym/Homing-v0`` (the entry point of its registration).
+class _Task(gym.Env):
+    """The learn-then-home task inside a :class:`HomingEnv`, as its wrappers see it.
+
+    Its spaces are the task's, ``reset`` and ``step`` are
+    :class:`~vc_gym.envs.LearnThenHomeEnv`'s own, and ``unwrapped`` is the
+    :class:`HomingEnv` (the wrappers read the task's attributes from there).
+    """
+
+    def __init__(self, env: HomingEnv):
+        self._env = env
+        self.observation_space = env.task_observation_space
+        self.action_space = env.task_action_space
+        self.metadata = env.metadata
+        self.render_mode = env.render_mode
+
+    @property
+    def unwrapped(self) -> HomingEnv:
+        return self._env
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        return self._env.np_random
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        return LearnThenHomeEnv.reset(self._env, seed=seed, options=options)
+
+    def step(self, action: np.ndarray):
+        return LearnThenHomeEnv.step(self._env, action)
+
+    def render(self) -> np.ndarray | None:
+        return LearnThenHomeEnv.render(self._env)
+
+    def close(self) -> None:
+        """Nothing: the :class:`HomingEnv` closes the task."""
+
+
+class HomingEnv(LearnThenHomeEnv):
+    """``vc_gym/Homing-v0``: the homing phase of the learn-then-home task as a learned
+    agent sees it.
+
+    ## Description
+
+    The task of :class:`~vc_gym.envs.LearnThenHomeEnv` (scripted learning phase inside
+    ``reset``, kidnapping, homing; paper 5.2), observed through the compass and a
+    tracker (:class:`~vc_gym.envs.CompassObservation`, eq. 23-32) as one feature vector
+    (:class:`HomingFeatures`) and acted on with walk, turn and stop decisions
+    (:class:`StopAction`). The env is one class: ``env.unwrapped`` is this env, with
+    these spaces and every attribute of the task (``atlas``, ``room``,
+    ``learning_result``, ``control_dt``, ...); the wrappers it applies inside are
+    :attr:`compass_observation`, :attr:`features`, :attr:`stop_action` (and
+    :attr:`previous_action_wrapper`). The settings of those wrappers
+    (``min_walk_m``, ``confirm_stop_m``, ``head_scan``, ``n_spots``, ...) are read and
+    set through the env, so ``get_wrapper_attr`` and ``set_wrapper_attr`` find them.
+
+    ## Action Space
+
+    ``Box(-1, 1, (3,), float32)``: walk (> 0 forward, scaled to ``max_forward`` m/s),
+    turn (left positive, scaled to ``max_turn_deg_s``), stop (> 0.5: stand still,
+    scanning with the head, until the task ends the episode). See :class:`StopAction`.
+
+    ## Observation Space
+
+    ``Box(-10, 10, (8 + n_spots,), float32)`` (``n_spots`` = 4 for the paper's spots):
+    home vector / 2 m, ``(cos θ̂, sin θ̂)``, heading spread / 180°, position / 2 m, log
+    goodness / 5 of each spot, head pan / 90° (:class:`HomingFeatures`); with
+    ``previous_action=True`` the last action taken follows (3 more entries).
+
+    ## Rewards, Starting State, Episode End, Info
+
+    The task's (:class:`~vc_gym.envs.LearnThenHomeEnv`); a stop decision's steps are
+    summed into one reward, and ``info["task_steps"]`` says how many task steps a
+    decision took. An episode lasts at most :attr:`max_episode_steps` decisions (the
+    registered ``max_episode_steps`` at the defaults).
 
     Parameters
     ----------
@@ -354,14 +418,139 @@ def make_homing_env(
         Append the last action to the features (:class:`PreviousAction`). Default False.
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
-        ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``relearn``, ...).
+        ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``learning_seed``,
+        ``place_cache``, ``atlas_file``, ...); its learning is scripted.
     """
-    home_offset_m = home_offset(home_offset_m)  # refused before a world is built
-    flag("previous_action", previous_action)
-    env = gym.make("vc_gym/LearnThenHome-v0", **task_kwargs)
-    env = CompassObservation(env, keep_image=False, tracker=tracker)
-    env = HomingFeatures(env, home_offset_m)
-    env = StopAction(
-        env, max_forward, max_turn_deg_s, min_walk_s, confirm_stop_m, head_scan, min_walk_m
-    )
-    return PreviousAction(env) if previous_action else env
+
+    def __init__(
+        self,
+        tracker: TrackerSpec = "grid",
+        max_forward: float = 0.4,
+        max_turn_deg_s: float = 60.0,
+        min_walk_s: float = 2.0,
+        confirm_stop_m: float | None = None,
+        head_scan: bool = True,
+        min_walk_m: float = 0.0,
+        home_offset_m: Any = (0.0, 0.0),
+        previous_action: bool = False,
+        **task_kwargs: Any,
+    ):
+        home_offset_m = home_offset(home_offset_m)  # refused before a world is built
+        self.previous_action = flag("previous_action", previous_action)
+        if task_kwargs.get("learning", "scripted") != "scripted":
+            raise ValueError("vc_gym/Homing-v0 learns the place by script (learning='scripted')")
+        super().__init__(**task_kwargs)
+        try:
+            #: The wrappers inside, innermost first.
+            self.compass_observation = CompassObservation(
+                _Task(self), keep_image=False, tracker=tracker
+            )
+            self.features = HomingFeatures(self.compass_observation, home_offset_m)
+            self.stop_action = StopAction(
+                self.features,
+                max_forward,
+                max_turn_deg_s,
+                min_walk_s,
+                confirm_stop_m,
+                head_scan,
+                min_walk_m,
+            )
+            self.previous_action_wrapper = (
+                PreviousAction(self.stop_action) if self.previous_action else None
+            )
+        except Exception:
+            LearnThenHomeEnv.close(self)
+            raise
+        self._outer: gym.Env = self.previous_action_wrapper or self.stop_action
+        self.observation_space = self._outer.observation_space
+        self.action_space = self._outer.action_space
+        # outermost first: where an attribute the env lacks is looked up
+        self._inner_wrappers = tuple(
+            w
+            for w in (
+                self.previous_action_wrapper,
+                self.stop_action,
+                self.features,
+                self.compass_observation,
+            )
+            if w is not None
+        )
+
+    def _owner(self, name: str) -> gym.Wrapper | None:
+        """The inner wrapper that holds ``name`` as its own attribute, outermost first."""
+        for w in self.__dict__.get("_inner_wrappers", ()):
+            if name in w.__dict__ or isinstance(getattr(type(w), name, None), property):
+                return w
+        return None
+
+    def __getattr__(self, name: str) -> Any:
+        # the settings of the wrappers inside (min_walk_m, confirm_stop_m, head_scan,
+        # n_spots, ...), as get_wrapper_attr finds them on a chain of wrappers
+        # (private names and a wrapper's own ``env`` stay private: the env is no wrapper)
+        owner = None if name.startswith("_") or name == "env" else self._owner(name)
+        if owner is None:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        return getattr(owner, name)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # set_wrapper_attr of a wrapper's setting reaches that wrapper
+        if not name.startswith("_") and name not in self.__dict__ and not hasattr(type(self), name):
+            owner = self._owner(name)
+            if owner is not None:
+                setattr(owner, name, value)
+                return
+        super().__setattr__(name, value)
+
+    # what callers read and set through get_wrapper_attr / set_wrapper_attr
+    @property
+    def tracker(self) -> Any:
+        """The tracker (:attr:`compass_observation`'s)."""
+        return self.compass_observation.tracker
+
+    @property
+    def last_state(self) -> Any:
+        """The tracker's last :class:`~vc_gym.localization.TrackerState`."""
+        return self.compass_observation.last_state
+
+    @property
+    def tracker_time_s(self) -> float:
+        """Wall time spent in the tracker's updates (a benchmark figure)."""
+        return self.compass_observation.tracker_time_s
+
+    @property
+    def tracker_updates(self) -> int:
+        """The tracker's updates so far."""
+        return self.compass_observation.tracker_updates
+
+    @property
+    def home_offset_m(self) -> tuple[float, float]:
+        """:attr:`features`' goal relative to the atlas' home (settable, checked)."""
+        return self.features.home_offset_m
+
+    @home_offset_m.setter
+    def home_offset_m(self, value: Any) -> None:
+        self.features.home_offset_m = home_offset(value)
+
+    @property
+    def max_forward(self) -> float:
+        """Walking speed of a full walk decision (m/s)."""
+        return self.stop_action.max_forward
+
+    @property
+    def max_turn_deg_s(self) -> float:
+        """Turn rate of a full turn decision (degrees per second)."""
+        return self.stop_action.max_turn_deg_s
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        return self._outer.reset(seed=seed, options=options)
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        return self._outer.step(action)
+
+
+def make_homing_env(**kwargs: Any) -> HomingEnv:
+    """``HomingEnv(**kwargs)``: ``vc_gym/Homing-v0`` without Gymnasium's checker
+    wrappers (kept for code that built the env this way; ``gym.make`` is the usual way)."""
+    return HomingEnv(**kwargs)

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -12,6 +14,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from vc_gym import ENV_SPECS, MAX_HOMING_S, MAX_LEARNING_S, time_limit_steps
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.envs.learning import (
@@ -24,6 +27,7 @@ from vc_gym.envs.learning import (
     kidnap_pose,
     paper_spots,
 )
+from vc_gym.envs.place_cache import CachedLearner, PlaceCache, place_key_value
 from vc_gym.poses import compose
 from vc_gym.sim.aibo_room import RESET_OPTIONS, AiboRoomEnv
 from vc_gym.validation import (
@@ -34,10 +38,24 @@ from vc_gym.validation import (
     positive_float,
 )
 
-__all__ = ["LearnThenHomeEnv", "LEARNING_MODES"]
+__all__ = ["EpisodeLimitWarning", "LearnThenHomeEnv", "LEARNING_MODES", "make_task"]
 
 LEARNING_MODES = ("scripted", "agent")
 RELEARN_MODES = ("scene", "episode")
+
+
+class EpisodeLimitWarning(UserWarning):
+    """``gym.make`` of a task whose episodes can outlast the registered
+    ``max_episode_steps``: its ``TimeLimit`` would end them early."""
+
+
+def make_task(env_id: str, **kwargs: Any) -> gym.Env:
+    """``gym.make(env_id, **kwargs)`` of a task that ends its episodes itself (its own
+    ``max_homing_s``), without Gymnasium's ``TimeLimit``: what the episode runner and
+    training use, whose time limits may exceed the registered horizon."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", EpisodeLimitWarning)
+        return gym.make(env_id, max_episode_steps=-1, **kwargs)
 
 
 @dataclass
@@ -100,8 +118,13 @@ class LearnThenHomeEnv(gym.Env):
 
     Terminated when the robot has stood still (``|forward|``, ``|sideways|`` and
     ``|turn|`` actions all ≤ ``still_threshold``; the head may move) for ``stop_time_s``
-    while homing (paper: 5 s), or falls; truncated after ``max_homing_s`` of homing or
-    ``max_learning_s`` of agent learning without finishing.
+    while homing (paper: 5 s), or falls; truncated after ``max_homing_s`` of homing
+    (:attr:`max_episode_steps` steps: 600 at the defaults, the registered
+    ``max_episode_steps``, so Gymnasium's ``TimeLimit`` truncates on the same step as
+    the env). With ``learning="agent"`` the learning phase ends after ``max_learning_s``
+    as if the agent had finished it, and an episode can last ``max_learning_s +
+    max_homing_s``: pass ``max_episode_steps=env.unwrapped.max_episode_steps`` to
+    ``gym.make`` (it warns otherwise), as for any ``max_homing_s`` above the default.
 
     ## Arguments
 
@@ -125,7 +148,14 @@ class LearnThenHomeEnv(gym.Env):
     env to need it learns and writes it, every later one (other workers too, under a
     lock) loads it instead of learning; a file learned with other settings is refused.
     With an ``atlas_file``, episodes do not depend on whether this env learned or
-    loaded the atlas.
+    loaded the atlas. Without one, the scripted learning phase is kept in the place
+    cache (``place_cache=True``, default; :mod:`vc_gym.envs.place_cache`): a place is
+    learned once per set of settings and learning seed, by the first env that needs it
+    (a progress bar on stderr), and loaded by every later env, in this run or another,
+    with bit-identical episodes. ``place_cache`` may also be a folder or a
+    :class:`~vc_gym.envs.place_cache.PlaceCache`; ``False`` (or ``None``) learns in
+    every env. Only the default learner is cached, and only when the learning seed is
+    known (``learning_seed``, or a seeded first reset).
 
     ## Info
 
@@ -147,8 +177,8 @@ class LearnThenHomeEnv(gym.Env):
         spot_distance_m: float = 1.0,
         stop_time_s: float = 5.0,
         success_radius_m: float = 0.3,
-        max_homing_s: float = 60.0,
-        max_learning_s: float = 300.0,
+        max_homing_s: float = MAX_HOMING_S,
+        max_learning_s: float = MAX_LEARNING_S,
         kidnap_margin_m: float = 0.5,
         still_threshold: float = 0.05,
         progress_reward: float = 10.0,
@@ -162,6 +192,7 @@ class LearnThenHomeEnv(gym.Env):
         normalise_at: str = "return",
         learning_seed: int | None = None,
         atlas_file: str | os.PathLike | None = None,
+        place_cache: bool | str | os.PathLike | PlaceCache | None = True,
         **room_kwargs: Any,
     ):
         if learning not in LEARNING_MODES:
@@ -202,6 +233,17 @@ class LearnThenHomeEnv(gym.Env):
             raise ValueError("atlas_file needs learning='scripted' (the agent learns its own)")
         if atlas_file is not None and room_kwargs.get("randomize"):
             raise ValueError("atlas_file cannot be shared by randomised scenes (each differs)")
+        if place_cache is None or isinstance(place_cache, bool):
+            cache = PlaceCache() if place_cache else None
+        elif isinstance(place_cache, PlaceCache):
+            cache = place_cache
+        elif isinstance(place_cache, (str, os.PathLike)):
+            cache = PlaceCache(place_cache)
+        else:
+            raise ValueError(
+                "place_cache must be True, False, None, a folder or a PlaceCache, "
+                f"got {place_cache!r}"
+            )
         self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
         self.render_mode = render_mode
         self.learning = learning
@@ -219,6 +261,9 @@ class LearnThenHomeEnv(gym.Env):
         self.success_radius_m = float(success_radius_m)
         self.max_homing_s = float(max_homing_s)
         self.max_learning_s = float(max_learning_s)
+        #: Steps of homing, and of the agent's learning, after which the phase ends.
+        self.homing_steps = time_limit_steps(self.max_homing_s, self.room.control_dt)
+        self.learning_steps = time_limit_steps(self.max_learning_s, self.room.control_dt)
         self.kidnap_margin_m = float(kidnap_margin_m)
         self.still_threshold = float(still_threshold)
         self.progress_reward = float(progress_reward)
@@ -234,6 +279,20 @@ class LearnThenHomeEnv(gym.Env):
                 "room": {k: repr(v) for k, v in sorted(room_kwargs.items())},
             }
             self.learner = AtlasFile(atlas_file, self.learner, spec)
+        #: The place cache the scripted learning phase uses (``None``: off).
+        self.place_cache = (
+            cache
+            if cache is not None
+            and atlas_file is None
+            and learning == "scripted"
+            and type(self.learner) is ScriptedLearning
+            else None
+        )
+        #: The place cache's learner of the last learning phase (``learned``: whether it
+        #: learned the place or loaded it), ``None`` if that phase was not cached.
+        self.cached_learner: CachedLearner | None = None
+        self._room_kwargs = dict(room_kwargs)
+        self._seeded = learning_seed is not None
         self.max_spots = 4 if learning == "scripted" else int(max_spots)
         self.spot_radius_m = float(spot_radius_m)
         self.control_dt = self.room.control_dt
@@ -244,6 +303,10 @@ class LearnThenHomeEnv(gym.Env):
         self.observation_space = spaces.Dict(
             {**self.room.observation_space.spaces, "phase": spaces.Box(0.0, 1.0, (1,), np.float32)}
         )
+        #: The task's own spaces (an env built on the task, such as ``vc_gym/Homing-v0``,
+        #: shows others as ``observation_space`` and ``action_space``).
+        self.task_observation_space = self.observation_space
+        self.task_action_space = self.action_space
 
         self.home = HOME  # where the robot must return (the world origin)
         self.atlas: CompassAtlas | None = None
@@ -252,7 +315,7 @@ class LearnThenHomeEnv(gym.Env):
         self._phase: str | None = None
         self._frames: list[_Frame] = []
         self._belief = np.zeros(3)  # dead-reckoned pose while the agent learns
-        self._phase_time = 0.0
+        self._phase_steps = 0
         self._still_steps = 0
         self._distance = 0.0
         self._pending_options: dict[str, Any] = {}
@@ -262,6 +325,55 @@ class LearnThenHomeEnv(gym.Env):
     def phase(self) -> str | None:
         """``"learning"``, ``"homing"`` or ``None`` before the first reset / after the end."""
         return self._phase
+
+    @property
+    def max_episode_steps(self) -> int:
+        """The most steps an episode can take: :attr:`homing_steps`, plus
+        :attr:`learning_steps` with ``learning="agent"``. At the default settings this is
+        the registered ``max_episode_steps``."""
+        if self.learning == "agent":
+            return self.learning_steps + self.homing_steps
+        return self.homing_steps
+
+    @property
+    def spec(self):
+        """The ``EnvSpec`` that ``gym.make`` gives the env (``None`` if built directly)."""
+        return self.__dict__.get("_spec")
+
+    @spec.setter
+    def spec(self, value) -> None:
+        self.__dict__["_spec"] = value
+        registered = ENV_SPECS.get(getattr(value, "id", None), (None, None))[1]
+        if registered is not None and self.max_episode_steps > registered:
+            warnings.warn(
+                f"{value.id} registers max_episode_steps={registered}, but this env's "
+                f"episodes can last {self.max_episode_steps} steps: unless you passed "
+                f"max_episode_steps={self.max_episode_steps} (or -1) to gym.make, its "
+                "TimeLimit ends them early",
+                EpisodeLimitWarning,
+                stacklevel=3,
+            )
+
+    def _cached_learner(self, learn_seed: int) -> CachedLearner | None:
+        """The place cache's learner of this learning phase, or ``None`` when the place
+        cannot be cached (no cache, another learner, an unknown learning seed, or room
+        settings with no description that is the same in every run)."""
+        if self.place_cache is None or not self._seeded:
+            return None
+        room = inspect.signature(AiboRoomEnv).bind(**self._room_kwargs)
+        room.apply_defaults()  # the same key whether a default is passed or left out
+        room = {k: v for k, v in room.arguments.items() if k != "render_mode"}
+        try:
+            key = {
+                "scene": self.room.scene_name,
+                "learner": repr(self.learner),
+                "learning": dataclasses.asdict(self.learn_config),
+                "learning_seed": int(learn_seed),
+                "room": place_key_value(room),
+            }
+            return self.place_cache.learner(self.learner, key)
+        except TypeError:
+            return None
 
     def _home_distance(self, info: dict[str, Any]) -> float:
         x, y = info["pose"][:2]
@@ -296,7 +408,7 @@ class LearnThenHomeEnv(gym.Env):
             pose = kidnap_pose(self.np_random, self.room.scene.field_bounds, self.kidnap_margin_m)
         obs, info = self.room.reset(seed=seed, options={"pose": pose})
         self._phase = "homing"
-        self._phase_time = 0.0
+        self._phase_steps = 0
         self._still_steps = 0
         self._distance = self._home_distance(info)
         return obs, info
@@ -324,10 +436,14 @@ class LearnThenHomeEnv(gym.Env):
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         self.room._check_open()
         options = check_reset_options(options, RESET_OPTIONS)
+        if seed is not None:
+            self._seeded = True
+        elif self._np_random is None:  # seeded from the OS: the learning seed is unknown
+            self._seeded = self.learning_seed is not None
         super().reset(seed=seed)
         room_seed = int(self.np_random.integers(2**31))
         self._still_steps = 0
-        self._phase_time = 0.0
+        self._phase_steps = 0
         if (
             self.learning == "scripted"
             and self.atlas is not None
@@ -349,8 +465,10 @@ class LearnThenHomeEnv(gym.Env):
         key = self.room.scene_key
         if self.atlas is None or self.relearn == "episode" or key != self._atlas_key:
             self.atlas = self.learning_result = None
+            self.cached_learner = self._cached_learner(learn_seed)
+            learner = self.cached_learner or self.learner
             try:
-                result = self.learner(self.room, self.learn_config)
+                result = learner(self.room, self.learn_config)
             except RobotFell as exc:
                 raise RuntimeError(
                     "the robot fell during the scripted learning phase; use "
@@ -373,18 +491,18 @@ class LearnThenHomeEnv(gym.Env):
         if self._phase is None:
             self.room._check_open()
             raise RuntimeError("call reset() before step() (the episode has ended or not begun)")
-        a = np.clip(check_action(action, self.action_space.shape), -1.0, 1.0)
+        a = np.clip(check_action(action, self.task_action_space.shape), -1.0, 1.0)
         if self._phase == "learning":
             return self._learning_step(a)
         obs, _, fell, _, info = self.room.step(a[:5])
-        self._phase_time += self.control_dt
+        self._phase_steps += 1
         d = self._home_distance(info)
         reward = self.progress_reward * (self._distance - d)
         self._distance = d
         self._still_steps = self._still_steps + 1 if self.is_still(a) else 0
         stopped = self._still_steps * self.control_dt >= self.stop_time_s - 1e-9
         terminated = fell or stopped
-        truncated = not terminated and self._phase_time >= self.max_homing_s - 1e-9
+        truncated = not terminated and self._phase_steps >= self.homing_steps
         info = self._info(info)
         if fell:
             reward -= self.fall_penalty
@@ -406,7 +524,7 @@ class LearnThenHomeEnv(gym.Env):
 
     def _learning_step(self, a: np.ndarray):
         obs, _, fell, _, info = self.room.step(a[:5])
-        self._phase_time += self.control_dt
+        self._phase_steps += 1
         odometry = tuple(float(v) for v in obs["odometry"])
         self._belief = np.array(compose(tuple(self._belief), odometry))
         if a[5] > 0:
@@ -419,7 +537,7 @@ class LearnThenHomeEnv(gym.Env):
             info = self._info(info)
             info.update(stopped=False, success=False, is_success=False)
             return self._obs(obs), -self.fall_penalty, True, False, info
-        if a[6] > 0 or self._phase_time >= self.max_learning_s - 1e-9:
+        if a[6] > 0 or self._phase_steps >= self.learning_steps:
             self.atlas = self._atlas_from_frames()
             self.learning_result = None
             if self.atlas is not None:

@@ -26,6 +26,7 @@ from vc_gym.agents.scripted import ScriptedHomingAgent
 from vc_gym.angles import wrap180
 from vc_gym.deprecation import renamed
 from vc_gym.envs.homing import LEARNED_CONFIRM_STOP_M
+from vc_gym.envs.learn_then_home import make_task
 from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
 
@@ -326,11 +327,13 @@ def make_agent_env(
     ``tracker`` is an env argument and whose stops are checked while it stands
     (:data:`LEARNED_CONFIRM_STOP_M`).
     """
+    # the task ends its episodes itself, after max_homing_s (which may exceed the
+    # registered horizon's 60 s): no TimeLimit
     if agent.observation == "compass":
-        env = gym.make(agent.env_id, **{**agent.env_kwargs, **task})
+        env = make_task(agent.env_id, **{**agent.env_kwargs, **task})
         return CompassObservation(env, keep_image=bool(keep_image), tracker=tracker)
     own = {"tracker": tracker, "confirm_stop_m": LEARNED_CONFIRM_STOP_M}
-    return gym.make(agent.env_id, **{**agent.env_kwargs, **own, **task})
+    return make_task(agent.env_id, **{**agent.env_kwargs, **own, **task})
 
 
 def check_agent_env(agent: HomingAgent, source: str) -> None:

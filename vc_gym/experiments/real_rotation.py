@@ -10,6 +10,7 @@ illumination test, section 5.3, on real photos); the training photos never are.
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable
@@ -157,7 +158,8 @@ def rotation_set_errors(
                 "width": cw,
                 "true_yaw_deg": p.yaw_deg,
                 "estimate_deg": est.heading_deg,
-                "spread_deg": est.spread_deg,
+                # a crop without evidence has an infinite spread: JSON has no infinity
+                "spread_deg": est.spread_deg if math.isfinite(est.spread_deg) else None,
             }
         )
     return {

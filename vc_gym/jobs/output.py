@@ -40,6 +40,7 @@ __all__ = [
     "read_json",
     "save_figure",
     "write_json",
+    "write_text",
 ]
 
 #: Longest file name (bytes) assumed where the file system does not say
@@ -298,9 +299,14 @@ def _sync_file(tmp: str) -> None:
 def write_json(path: str | os.PathLike, obj: object) -> None:
     """Write ``obj`` as indented JSON to ``path`` atomically and durably (its folder is
     created; the temporary file is synced before the rename, the folder after it)."""
+    write_text(path, json.dumps(obj, indent=2))
+
+
+def write_text(path: str | os.PathLike, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically and durably, as :func:`write_json`."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    data = json.dumps(obj, indent=2).encode("utf-8")
+    data = text.encode("utf-8")
     write_atomic(path, lambda tmp: _write_synced(tmp, data))
     _fsync_dir(path.parent if str(path.parent) else Path("."))
 

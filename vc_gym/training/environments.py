@@ -14,6 +14,7 @@ from pathlib import Path
 
 import gymnasium as gym
 
+from vc_gym.envs.learn_then_home import make_task
 from vc_gym.envs.place_pool import PlacePool
 from vc_gym.training.config import TrainConfig
 
@@ -23,7 +24,8 @@ __all__ = ["EnvFactory", "learn_places", "place_env", "run_places", "training_en
 def place_env(config: TrainConfig, seed: int, atlas_file: Path) -> gym.Env:
     """``vc_gym/Homing-v0`` of one place: learning seed ``seed``, its atlas learned once
     into ``atlas_file`` by the first env that needs it and loaded by every other."""
-    return gym.make(
+    # the task ends its episodes itself (max_homing_s may exceed the registered 60 s)
+    return make_task(
         "vc_gym/Homing-v0", **config.env_kwargs(), atlas_file=str(atlas_file), learning_seed=seed
     )
 

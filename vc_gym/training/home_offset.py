@@ -224,11 +224,14 @@ def _default_expert(env: gym.Env) -> HomingFeatureExpert:
 
 
 def _has_wrapper(env: gym.Env, kind: type) -> bool:
+    """Whether ``env`` applies ``kind``: as one of its wrappers, or inside its unwrapped
+    env (``vc_gym/Homing-v0`` applies its wrappers itself)."""
     while isinstance(env, gym.Wrapper):
         if isinstance(env, kind):
             return True
         env = env.env
-    return False
+    inner = getattr(env, "previous_action_wrapper", None) if kind is PreviousAction else None
+    return isinstance(inner, kind)
 
 
 def _homing_round(

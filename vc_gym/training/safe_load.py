@@ -44,6 +44,7 @@ __all__ = [
     "UnsafeModelError",
     "check_net_arch",
     "load_sb3_model",
+    "model_algo",
 ]
 
 #: Largest uncompressed size of one entry of a model zip, and of all entries together.
@@ -114,6 +115,19 @@ def _schedule(entry: dict[str, Any], name: str):
     return FloatSchedule(ConstantSchedule(float(m.group(1))))
 
 
+def _constant_schedule(entry: dict[str, Any], name: str) -> float:
+    """A ``ConstantSchedule`` (what the RL Zoo saves as ``learning_rate``) as its value."""
+    if entry.get(":type:") != "<class 'stable_baselines3.common.utils.ConstantSchedule'>":
+        raise UnsafeModelError(f"{name}: only a constant schedule can be loaded safely")
+    try:
+        value = float(str(entry.get("val")))
+    except ValueError:
+        raise UnsafeModelError(f"{name}: its value is not a number") from None
+    if not (math.isfinite(value) and 0.0 < value <= 1.0):
+        raise UnsafeModelError(f"{name}: {value} is out of bounds")
+    return value
+
+
 def _replacements(algo: str) -> dict[str, Callable[[dict[str, Any], str], Any]]:
     from stable_baselines3 import PPO, SAC
     from stable_baselines3.common.buffers import ReplayBuffer, RolloutBuffer
@@ -126,6 +140,7 @@ def _replacements(algo: str) -> dict[str, Callable[[dict[str, Any], str], Any]]:
         "observation_space": lambda e, n: _box(e, n, 10.0, range(9, 1033)),
         "action_space": lambda e, n: _box(e, n, 1.0, range(3, 4)),
         "lr_schedule": _schedule,
+        "learning_rate": _constant_schedule,  # the RL Zoo's
         "clip_range": _schedule,
         # training state that learn() rebuilds when it is missing
         "_last_obs": lambda e, n: None,
@@ -472,3 +487,29 @@ def load_sb3_model(
     except UnsafeModelError as exc:
         raise UnsafeModelError(f"{p}: {exc}; not loaded") from None
     return cls.load(_sanitised_zip(p, plain), env=env, device=device, custom_objects=custom)
+
+
+def model_algo(path: str | os.PathLike) -> str:
+    """Which algorithm wrote a ``model.zip``: ``"ppo"`` or ``"sac"``, told by the names of
+    the tensors in its ``policy.pth`` (read with ``torch.load(weights_only=True)``, after
+    the zip's entries are checked as for :func:`load_sb3_model`).
+
+    Raises
+    ------
+    UnsafeModelError
+        Naming the file: not a readable model zip, or weights of neither algorithm's
+        ``MlpPolicy``.
+    """
+    p = Path(path)
+    try:
+        _checked_data(p)
+        names = set(_weight_shapes(p))
+    except UnsafeModelError as exc:
+        raise UnsafeModelError(f"{p}: {exc}") from None
+    if {"action_net.weight", "value_net.weight", "log_std"} <= names:
+        return "ppo"
+    if {"actor.mu.weight", "actor.log_std.weight"} <= names and any(
+        n.startswith("critic.qf0.") for n in names
+    ):
+        return "sac"
+    raise UnsafeModelError(f"{p}: the weights are neither a PPO nor a SAC MlpPolicy's")

@@ -186,6 +186,16 @@ EXPERIMENTS: dict[str, Experiment] = {
             jobs=False,
         ),
         Experiment(
+            "calibration",
+            _P + "calibration",
+            "is the compass' heading spread calibrated? share of true headings within ±1σ "
+            "and ±2σ, median |error| and spread, uncalibrated and with the temperature "
+            "fitted at map time (leave-one-out over the learning turn): views at 0, 1 and "
+            "2 m from the spot in every scene over learning seeds, and crops of the real "
+            "rotation sets (cross-fitted)",
+            _options("scenes", "seeds", "data_dir"),
+        ),
+        Experiment(
             "synthetic-compass",
             "vc_gym.experiments.synthetic_compass",
             "synthetic room and outdoor panoramas at normal and half illumination",
