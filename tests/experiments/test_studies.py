@@ -244,6 +244,21 @@ def test_a_dead_worker_fails_its_jobs_clearly_not_the_run(homing_quick, tmp_path
     assert all(f["attempts"] == 2 for f in results["failed_jobs"])
 
 
+@pytest.mark.slow
+def test_evaluate_writes_its_results_page(homing_quick, tmp_path, capsys):
+    out, page = tmp_path / "run", tmp_path / "docs" / "homing.md"
+    shutil.copytree(homing_quick / "atlases", out / "atlases")
+    argv = ["evaluate", "--out", str(out), "--episodes", "1", "--workers", "1"]
+    argv += ["--learn-time", "0.3", "--max-homing", "15", "--page", str(page)]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    text = page.read_text()
+    assert text.startswith("# `vc-gym evaluate`")
+    assert f"`vc-gym {' '.join(argv)}`" in text
+    assert printed.splitlines()[0] in text  # the figures exactly as printed
+    assert (page.with_suffix("") / "stop_positions.png").is_file()
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 from pathlib import Path
 from typing import Any
 
@@ -88,6 +89,12 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--out", default="vc_gym_homing", metavar="DIR", help="output folder (resumable)"
     )
+    p.add_argument(
+        "--page",
+        metavar="FILE.md",
+        help="also write a results page of the docs (e.g. docs/results/homing.md): "
+        "command, version and commit, date, machine, seeds, figures, plots",
+    )
     add_json_option(p)
     p.set_defaults(func=run, hint=experiment_command.resume_hint)
 
@@ -159,4 +166,6 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         workers=args.workers,
         json_output=args.json,
+        page=args.page,
+        command_line="vc-gym " + shlex.join(getattr(args, "argv", [])),
     )

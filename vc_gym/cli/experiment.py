@@ -180,7 +180,7 @@ def run_experiment(
         written = write_page(
             page,
             PageInfo(
-                title=f"`vc-gym experiment {e.name}`",
+                title=f"`vc-gym {command if command != 'experiment' else 'experiment ' + e.name}`",
                 command=command_line or f"vc-gym experiment {e.name} --page {page}",
                 description=e.help,
                 seeds=seeds_text(results, seed),
