@@ -173,7 +173,38 @@ def test_grid_learning_around_each_spot_adds_four_turns_to_its_map():
     assert "around_m=0.4" in repr(GridLearning([(0.0, 0.0)], around_m=0.4))
 
 
-@pytest.mark.parametrize("kwargs", [{"around_m": -0.1}, {"around_m": np.nan}, {"around_steps": 0}])
+@pytest.mark.slow
+def test_grid_learning_can_keep_the_turns_around_as_entries_of_their_own():
+    env = gym.make("vc_gym/AiboRoom-v0", max_episode_steps=10**7)
+    room = env.unwrapped
+    room.reset(seed=0)
+    config = LearningConfig(learn_time_s=0.5)
+    merged = GridLearning([(0.0, 0.0)], around_m=0.4, around_steps=2)(room, config)
+    kept = GridLearning([(0.0, 0.0)], around_m=0.4, around_steps=2, keep_around=True)(
+        room, config
+    )
+    env.close()
+    atlas = kept.atlas
+    assert atlas.names == ("spot0", "spot0.e", "spot0.w", "spot0.n", "spot0.s")
+    np.testing.assert_allclose(atlas.positions, [[0, 0], [0.4, 0], [-0.4, 0], [0, 0.4], [0, -0.4]])
+    assert atlas.home == "spot0"
+    assert [vc.frames_learned for vc in atlas.compasses] == [8 * 5] + [8 * 2] * 4
+    total = sum(vc.frames_learned for vc in atlas.compasses)
+    assert total == merged.atlas.compasses[0].frames_learned
+    assert all(vc.shares_colors(atlas.compasses[0]) for vc in atlas.compasses)
+    assert "keep_around=True" in repr(GridLearning([(0.0, 0.0)], 0.4, keep_around=True))
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"around_m": -0.1},
+        {"around_m": np.nan},
+        {"around_steps": 0},
+        {"keep_around": True},
+        {"around_m": 0.5, "keep_around": "yes"},
+    ],
+)
 def test_grid_learning_rejects_bad_around_settings(kwargs):
     with pytest.raises(ValueError, match="around"):
         GridLearning([(0.0, 0.0)], **kwargs)

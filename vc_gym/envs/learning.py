@@ -26,7 +26,13 @@ from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
-from vc_gym.validation import finite_float, int_at_least, nonnegative_float, positive_float
+from vc_gym.validation import (
+    finite_float,
+    flag,
+    int_at_least,
+    nonnegative_float,
+    positive_float,
+)
 
 __all__ = [
     "HEAD_SCAN_DEG",
@@ -502,7 +508,11 @@ class GridLearning:
     then holds how the view changes within ``around_m`` of its spot, so it still fits,
     with the right heading, a robot that stands between spots: over the robolab field
     the heading error from the best-fitting map fell by about a third with 0.5 m
-    (``vc-gym experiment orientation --modes spot-grid``).
+    (``vc-gym experiment orientation --modes spot-grid``). With ``keep_around=True`` the
+    four turns are kept as atlas entries of their own instead, at the points where they
+    were learned and named after their spot (``spot3.e``, ``spot3.w``, ``spot3.n``,
+    ``spot3.s``), so a tracker can re-draw a spot's map for a nearby position from them
+    (:class:`~vc_gym.compass.ParallaxMap`).
 
     Parameters
     ----------
@@ -513,12 +523,25 @@ class GridLearning:
     around_steps : int, optional
         Frames per direction of each extra turn; default a quarter of the spot's own
         (so the four extra turns together take as long as the spot's).
+    keep_around : bool
+        Keep the extra turns as entries of their own (default False: merged into the
+        spot's map). Needs ``around_m > 0``.
     """
+
+    #: The names of the turns around a spot, after the spot's name and a dot, in the
+    #: order east, west, north, south.
+    around_names = ("e", "w", "n", "s")
 
     #: Spot names are this prefix and the spot's index.
     prefix = "spot"
 
-    def __init__(self, spots, around_m: float = 0.0, around_steps: int | None = None):
+    def __init__(
+        self,
+        spots,
+        around_m: float = 0.0,
+        around_steps: int | None = None,
+        keep_around: bool = False,
+    ):
         try:
             pts = [(finite_float("spot x", x), finite_float("spot y", y)) for x, y in spots]
         except (TypeError, ValueError):
@@ -530,9 +553,13 @@ class GridLearning:
         self.around_steps = (
             None if around_steps is None else int_at_least("around_steps", around_steps, 1)
         )
+        self.keep_around = flag("keep_around", keep_around)
+        if self.keep_around and not self.around_m:
+            raise ValueError("keep_around=True needs turns around the spots (around_m > 0)")
 
     def __repr__(self) -> str:
         extra = f", around_m={self.around_m}" if self.around_m else ""
+        extra += ", keep_around=True" if self.keep_around else ""
         return f"GridLearning(spots={self.spots}{extra})"
 
     def _around(self, spot: tuple[float, float]) -> list[tuple[float, float]]:
@@ -547,7 +574,8 @@ class GridLearning:
         Returns
         -------
         LearningResult
-            ``atlas``: the spots ``spot0``, ``spot1``, ... at their positions, home
+            ``atlas``: the spots ``spot0``, ``spot1``, ... at their positions (with
+            ``keep_around``, each followed by its turns ``spot0.e``, ... at theirs), home
             ``spot0``, not normalised; ``spots``; ``true_path``: the true poses of every
             turn's frames; ``odometry_turn_scale``: the first spot's loop closure.
 
@@ -566,11 +594,16 @@ class GridLearning:
                 colors, scale = compass.colors, learner.rot_scale
             path.extend(learner.turn_path)
             steps = self.around_steps or max(1, learner.steps_per_direction() // 4)
-            for place in self._around(spot):
+            name = f"{self.prefix}{i}"
+            maps[name] = (spot, compass)
+            for side, place in zip(self.around_names, self._around(spot), strict=False):
                 room.reset(options={"pose": (*place, 0.0)})
-                compass.merge(learner.learn_turn(steps, colors=colors))
+                turn = learner.learn_turn(steps, colors=colors)
                 path.extend(learner.turn_path)
-            maps[f"{self.prefix}{i}"] = (spot, compass)
+                if self.keep_around:
+                    maps[f"{name}.{side}"] = (place, turn)
+                else:
+                    compass.merge(turn)
         atlas = CompassAtlas(maps, home=f"{self.prefix}0")
         names = {n: p for n, (p, _) in maps.items()}
         return LearningResult(atlas, names, path, scale)

@@ -45,6 +45,7 @@ def atlas_spec(
     learning: Mapping[str, Any] | None = None,
     spots: Sequence[Sequence[float]] | None = None,
     around_m: float = 0.0,
+    keep_around: bool = False,
 ) -> dict[str, Any]:
     """What identifies a learned atlas (a JSON dict; see :func:`learn_atlas_job`).
 
@@ -74,6 +75,9 @@ def atlas_spec(
     around_m : float
         The ``"grid"`` learner's extra turns around each spot (``GridLearning``'s
         ``around_m``; 0: none).
+    keep_around : bool
+        Keep those turns as atlas entries of their own (``GridLearning``'s
+        ``keep_around``).
     """
     if learner not in LEARNERS:
         raise ValueError(f"learner must be one of {LEARNERS}, got {learner!r}")
@@ -81,10 +85,10 @@ def atlas_spec(
         raise ValueError("spot is needed by, and only by, the 'spot' learner")
     if (learner == "grid") != (spots is not None):
         raise ValueError("spots are needed by, and only by, the 'grid' learner")
-    if around_m and learner != "grid":
-        raise ValueError("around_m belongs to the 'grid' learner")
+    if (around_m or keep_around) and learner != "grid":
+        raise ValueError("around_m and keep_around belong to the 'grid' learner")
     if spots is not None:
-        grid = GridLearning(spots, around_m)
+        grid = GridLearning(spots, around_m, keep_around=keep_around)
         spots, around_m = [[float(x), float(y)] for x, y in grid.spots], grid.around_m
     config = CompassConfig(**dict(compass or {}))  # validates the fields
     learning = dict(learning or {})
@@ -106,6 +110,8 @@ def atlas_spec(
         spec["spots"] = spots
     if around_m:  # only when set, so that it changes no other grid spec's atlas key
         spec["around_m"] = float(around_m)
+    if keep_around:  # likewise
+        spec["keep_around"] = True
     if learning:  # only when set, so that it changes no paper spec's atlas key
         spec["learning"] = learning
     json.dumps(spec, allow_nan=False)  # JSON values only
@@ -122,7 +128,11 @@ def _learner(spec: Mapping[str, Any]):
     if spec["learner"] == "spot":
         return SpotLearning(tuple(spec["spot"]))
     if spec["learner"] == "grid":
-        return GridLearning([tuple(p) for p in spec["spots"]], spec.get("around_m", 0.0))
+        return GridLearning(
+            [tuple(p) for p in spec["spots"]],
+            spec.get("around_m", 0.0),
+            keep_around=bool(spec.get("keep_around", False)),
+        )
     return None  # the task's default: the paper's scripted learning
 
 
