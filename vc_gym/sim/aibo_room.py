@@ -97,8 +97,8 @@ class AiboRoomEnv(gym.Env):
     odometry_noise=None, camera=None, render_mode=None)``
 
     * ``scene``: a registered scene name (``vc_gym.envs.scene_names()``: the built-in
-      ``"robolab"``, ``"office"``, ``"home"``, ``"outdoor_field"`` and any registered
-      with ``vc_gym.sim.register_scene``).
+      ``"robolab"``, ``"office"``, ``"home"``, ``"outdoor_field"``, ``"plain_house"`` and
+      any registered with ``vc_gym.sim.register_scene``).
     * ``randomize``: domain randomisation of textures, posters, furniture and light,
       drawn from the reset seed.
     * ``locomotion``: ``"constraint"`` (default: the base follows the commanded motion

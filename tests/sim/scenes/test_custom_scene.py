@@ -198,5 +198,5 @@ def test_cli_refuses_an_unknown_scene_before_any_work(command, tmp_path, capsys,
     assert e.value.code == 2
     err = capsys.readouterr().err
     assert f"invalid choice: '{BOX_ROOM}'" in err
-    assert "'robolab', 'office', 'home', 'outdoor_field'" in err
+    assert "'robolab', 'office', 'home', 'outdoor_field', 'plain_house'" in err
     assert list(tmp_path.iterdir()) == []

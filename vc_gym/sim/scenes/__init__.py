@@ -1,4 +1,4 @@
-"""The simulated scenes: a registry of named scene builders, four of them built in.
+"""The simulated scenes: a registry of named scene builders, five of them built in.
 
 Built-in scenes (:data:`SCENES`), the paper's robot lab and its "other environments"
 (section 5):
@@ -12,7 +12,12 @@ Built-in scenes (:data:`SCENES`), the paper's robot lab and its "other environme
   paintings (:mod:`vc_gym.sim.scenes.home`);
 * ``"outdoor_field"``: a grass pitch with advertising boards, floodlights, a
   grandstand, trees and buildings inside a sky cylinder
-  (:mod:`vc_gym.sim.scenes.outdoor_field`).
+  (:mod:`vc_gym.sim.scenes.outdoor_field`);
+* ``"plain_house"``: a living room as plain as a real house, 5.5 x 4.5 m: off-white
+  walls, white ceiling, light wooden floor, a grey sofa, a white wardrobe, a table with
+  two chairs, a low shelf, two bright windows, a door and two small prints, no posters
+  (:mod:`vc_gym.sim.scenes.plain_house`): the other rooms are much busier than real
+  houses, which flatters an appearance-based compass.
 
 Every built-in scene is *closed* (walls and ceiling, or the sky cylinder and its lid), so
 every camera ray hits something and :attr:`Scene.background_rgb` is ``None``.
@@ -116,7 +121,7 @@ from vc_gym.sim.scenes.scene import Scene, SceneLayout
 
 #: Names of the BUILT-IN scenes, kept for backwards compatibility. Scenes registered
 #: later are not in it: use :func:`scene_names` for every registered scene.
-SCENES: tuple[str, ...] = ("robolab", "office", "home", "outdoor_field")
+SCENES: tuple[str, ...] = ("robolab", "office", "home", "outdoor_field", "plain_house")
 
 # each built-in scene's module registers it on import; in this order, so that
 # scene_names() and error messages list them as SCENES does

@@ -1,9 +1,11 @@
 """Furniture and wall decorations for rooms made with :class:`~vc_gym.sim.scenes.rooms.Room`.
 
 Wall decorations (:func:`hang_pictures`, :func:`door`, :func:`window`, :func:`baseboard`)
-are painted on a :class:`~vc_gym.sim.scenes.rooms.Wall`'s canvas and take their area;
-furniture (:func:`workstation`, :func:`chair`, :func:`shelf`, :func:`cabinet`,
-:func:`plant`, :func:`sofa`, :func:`floor_lamp`) is built from parts placed along a wall:
+are painted on a :class:`~vc_gym.sim.scenes.rooms.Wall`'s canvas and take their area
+(:func:`bright_window` adds glass panes of their own to a painted window); furniture
+(:func:`workstation`, :func:`chair`, :func:`shelf`, :func:`cabinet`, :func:`plant`,
+:func:`sofa`, :func:`floor_lamp`, :func:`wardrobe`, :func:`dining_table`,
+:func:`dining_chair`) is built from parts placed along a wall:
 ``side`` is the wall (``"E"``, ``"N"``, ``"W"``, ``"S"``), ``u`` the position along it
 seen from inside (left to right) and ``d`` the distance out of it, in metres. Colours
 are RGB 0..255; every random draw comes from the builder's generator (``b.rng``) or its
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -25,9 +28,12 @@ from vc_gym.sim.scenes.rooms import Room, Wall
 
 __all__ = [
     "baseboard",
+    "bright_window",
     "cabinet",
     "ceiling_texture",
     "chair",
+    "dining_chair",
+    "dining_table",
     "door",
     "floor_lamp",
     "hang_pictures",
@@ -36,6 +42,7 @@ __all__ = [
     "sofa",
     "sun",
     "wall_colors",
+    "wardrobe",
     "window",
     "workstation",
 ]
@@ -124,7 +131,7 @@ def hang_pictures(
     return hung
 
 
-def door(b: Builder, wall: Wall, u0: float, width: float = 0.9) -> None:
+def door(b: Builder, wall: Wall, u0: float, width: float = 0.9, leaf: RGB | None = None) -> None:
     """Paint a 2.05 m high door with its casing on ``wall`` from ``u0`` and take the area.
 
     Parameters
@@ -137,9 +144,15 @@ def door(b: Builder, wall: Wall, u0: float, width: float = 0.9) -> None:
         Left edge of the door along the wall (m).
     width : float
         Width of the door (m).
+    leaf : sequence of float, optional
+        Canonical colour of the door leaf, varied only a little when randomising
+        (default: a wooden door of any colour when randomising).
     """
     v = b.choices
-    leaf = v.color((150, 105, 65), dh=0.5, ds=0.4, dv=0.3)
+    if leaf is None:
+        leaf = v.color((150, 105, 65), dh=0.5, ds=0.4, dv=0.3)
+    else:
+        leaf = v.color(leaf, dh=0.05, ds=0.05, dv=0.08)
     casing = v.color((238, 236, 230), dh=0.1, ds=0.05, dv=0.08)
     wall.canvas.door(u0, u0 + width, 2.05, leaf, casing)
     wall.take(u0 - 0.1, u0 + width + 0.1, 0.0, 2.15)
@@ -156,6 +169,7 @@ def window(
     radiator: bool = True,
     blinds: RGB | None = None,
     curtains: RGB | None = None,
+    view: np.ndarray | None = None,
 ) -> None:
     """Paint a window with a view outside on ``wall`` and take the area.
 
@@ -173,17 +187,83 @@ def window(
         Colour of half-closed blinds.
     curtains : sequence of float, optional
         Colour of curtains beside it.
+    view : numpy.ndarray, optional
+        ``(H, W, 3)`` ``uint8`` RGB picture of what the glass shows (default: a view of
+        sky, trees and lawn painted from ``b.rng``).
     """
     c = wall.canvas
     if curtains is not None:
         c.curtains(u0, u1, z0 - 0.3, min(z1 + 0.2, wall.height - 0.05), curtains, 0.35)
-    c.window(u0, u1, z0, z1, tx.outdoor_view(b.rng), mullions=1 if u1 - u0 > 1.0 else 0)
+    if view is None:
+        view = tx.outdoor_view(b.rng)
+    c.window(u0, u1, z0, z1, view, mullions=1 if u1 - u0 > 1.0 else 0)
     if blinds is not None:
         c.blinds(u0 + 0.06, u1 - 0.06, z0 + 0.06, z1 - 0.06, blinds)
     if radiator:
         c.radiator(u0 + 0.1, u1 - 0.1, 0.15, min(0.65, z0 - 0.15))
     pad = 0.45 if curtains is not None else 0.1
     wall.take(u0 - pad, u1 + pad, 0.0 if radiator else z0 - 0.1, z1 + 0.1)
+
+
+def bright_window(
+    b: Builder,
+    room: Room,
+    side: str,
+    u0: float,
+    u1: float,
+    z0: float,
+    z1: float,
+    light: Sequence[float],
+    *,
+    radiator: bool = True,
+    view: np.ndarray | None = None,
+) -> None:
+    """A :func:`window` whose glass is as bright as daylight through a real window.
+
+    A painted window is shaded like the wall it is on (a wall facing away from the light
+    shows its view at ~60 % brightness); here the panes are quads of their own, 2 mm in
+    front of the wall, shaded as if they faced ``light``, so they show ``view`` at full
+    brightness from every side. The frame, sill and radiator are painted as by
+    :func:`window`.
+
+    Parameters
+    ----------
+    b : Builder
+        The scene's builder (its ``rng`` paints the default view).
+    room : Room
+        The room.
+    side : str
+        The wall.
+    u0, u1, z0, z1 : float
+        The window's extent along the wall and its sill and top heights (m).
+    light : sequence of float
+        The scene's light direction (towards the light).
+    radiator : bool
+        Paint a radiator below it.
+    view : numpy.ndarray, optional
+        What the glass shows (default: :func:`vc_gym.sim.textures.outdoor_view`).
+    """
+    if view is None:
+        view = tx.outdoor_view(b.rng)
+    window(b, room.walls[side], u0, u1, z0, z1, radiator=radiator, view=view)
+    # the panes between the bars Canvas.window paints: a 6 cm frame, a 6 cm mullion in
+    # the middle of windows wider than 1 m and a 6 cm transom at 62 % of the height
+    f, bar = 0.06, 0.03
+    ga, gb, gc, gd = u0 + f, u1 - f, z0 + f, z1 - f
+    cols = [ga, gb] if u1 - u0 <= 1.0 else [ga, (u0 + u1) / 2 - bar, (u0 + u1) / 2 + bar, gb]
+    zt = z0 + 0.62 * (z1 - z0)
+    quads = []
+    for a, c in zip(cols[::2], cols[1::2], strict=True):
+        for lo, hi in ((gc, zt - bar), (zt + bar, gd)):
+            origin, du, dv, _ = room.quad(side, a, c, lo, hi, 0.002)
+            uv = (
+                (a - ga) / (gb - ga),
+                (lo - gc) / (gd - gc),
+                (c - ga) / (gb - ga),
+                (hi - gc) / (gd - gc),
+            )
+            quads.append((origin, du, dv, uv))
+    b.mesh(quads, view, normal=light)
 
 
 def baseboard(wall: Wall, rgb: RGB, height: float = 0.08) -> None:
@@ -313,6 +393,7 @@ def shelf(
     depth: float = 0.35,
     frame: RGB = (120, 85, 55),
     binders: bool = False,
+    palette: Sequence[RGB] | None = None,
 ) -> None:
     """A bookshelf with coarse blocks of coloured books or binders on its shelves.
 
@@ -332,6 +413,9 @@ def shelf(
         Colour of the frame.
     binders : bool
         Taller, deeper blocks like office binders.
+    palette : sequence of RGB, optional
+        Colours of the books (each block one of them, a little lighter or darker);
+        default: any colour.
     """
     rng = b.rng
     frame = np.asarray(frame, np.float32)
@@ -354,7 +438,11 @@ def shelf(
             bw = float(min(rng.uniform(0.12, 0.4), u0 + width - t - 0.02 - u))
             if rng.uniform() < 0.8:
                 zt = z0 + 0.025 + (z1 - z0 - 0.04) * rng.uniform(0.65 if binders else 0.55, 0.95)
-                c = tx.random_color(rng, s=(0.4, 1.0), v=(0.35, 0.95))
+                if palette is None:
+                    c = tx.random_color(rng, s=(0.4, 1.0), v=(0.35, 0.95))
+                else:
+                    c = np.asarray(palette[int(rng.integers(len(palette)))], np.float32)
+                    c = c * np.float32(rng.uniform(0.9, 1.08))
                 dd = depth - 0.03 if binders else depth - 0.06
                 parts.append(room.box(side, u, u + bw, 0.03, dd, z0 + 0.025, zt, c))
             u += bw + 0.01
@@ -446,7 +534,15 @@ def plant(b: Builder, room: Room, side: str, u: float, d: float, big: bool = Tru
     b.solid(parts)
 
 
-def sofa(b: Builder, room: Room, side: str, u0: float, width: float, rgb: RGB) -> None:
+def sofa(
+    b: Builder,
+    room: Room,
+    side: str,
+    u0: float,
+    width: float,
+    rgb: RGB,
+    pillows: RGB | None = None,
+) -> None:
     """A sofa with cushions and pillows, ``width`` long, 0.9 m deep, against wall ``side``.
 
     Parameters
@@ -463,6 +559,8 @@ def sofa(b: Builder, room: Room, side: str, u0: float, width: float, rgb: RGB) -
         Its length (m).
     rgb : sequence of float
         Upholstery colour.
+    pillows : sequence of float, optional
+        Colour of both pillows (default: two random bright colours).
     """
     rng = b.rng
     c = np.asarray(rgb, np.float32)
@@ -481,7 +579,10 @@ def sofa(b: Builder, room: Room, side: str, u0: float, width: float, rgb: RGB) -
             room.box(side, ua + 0.01, ua + cw - 0.01, 0.3, depth - 0.02, 0.42, 0.53, c * 1.05)
         )
     for ua in (u0 + 0.25, u0 + width - 0.65):
-        pillow = tx.random_color(rng, s=(0.5, 1.0), v=(0.6, 1.0))
+        if pillows is None:
+            pillow = tx.random_color(rng, s=(0.5, 1.0), v=(0.6, 1.0))
+        else:
+            pillow = pillows
         parts.append(room.box(side, ua, ua + 0.4, 0.3, 0.45, 0.53, 0.88, pillow))
     for ua in (u0 + 0.03, u0 + width - 0.08):
         parts.append(room.box(side, ua, ua + 0.05, 0.1, 0.15, 0.0, 0.08, (50, 35, 25)))
@@ -490,6 +591,140 @@ def sofa(b: Builder, room: Room, side: str, u0: float, width: float, rgb: RGB) -
         )
     b.solid(parts)
     room.walls[side].take(u0, u0 + width, 0.0, 0.95)
+
+
+def wardrobe(
+    b: Builder,
+    room: Room,
+    side: str,
+    u0: float,
+    width: float = 1.2,
+    height: float = 2.1,
+    depth: float = 0.6,
+    rgb: RGB = (232, 230, 224),
+) -> None:
+    """A plain wardrobe with two (or three, from 1.3 m wide) doors against wall ``side``.
+
+    The doors stand a little proud of the carcass with a dark gap between them and a
+    slim vertical handle each; the plinth is recessed and darker.
+
+    Parameters
+    ----------
+    b : Builder
+        The scene's builder.
+    room : Room
+        The room.
+    side : str
+        The wall it stands against.
+    u0 : float
+        Its left end along the wall (m).
+    width, height, depth : float
+        Its size (m); the doors add 2 cm to the depth.
+    rgb : sequence of float
+        Its colour.
+    """
+    body = np.asarray(rgb, np.float32)
+    n = 2 if width < 1.3 else 3
+    dw = width / n
+    handle = (150, 150, 152)
+    parts = [
+        room.box(side, u0, u0 + width, 0.0, depth, 0.07, height, body),
+        room.box(side, u0 + 0.03, u0 + width - 0.03, 0.0, depth - 0.03, 0.0, 0.07, body * 0.5),
+    ]
+    front, top = depth + 0.02, height - 0.02
+    for k in range(n):
+        a = u0 + k * dw
+        parts.append(
+            room.box(side, a + 0.007, a + dw - 0.007, depth, front, 0.08, top, body * 0.97)
+        )
+        if k > 0:  # the dark gap between two doors
+            parts.append(
+                room.box(side, a - 0.01, a + 0.01, depth, front - 0.008, 0.08, top, body * 0.45)
+            )
+        hu = a + dw - 0.07 if k % 2 == 0 else a + 0.05
+        parts.append(room.box(side, hu, hu + 0.02, front, front + 0.025, 0.85, 1.25, handle))
+    b.solid(parts)
+    room.walls[side].take(u0, u0 + width, 0.0, height)
+
+
+def dining_chair(
+    b: Builder, room: Room, side: str, u0: float, d0: float, facing: int, rgb: RGB
+) -> None:
+    """A plain wooden chair, 0.42 m square, its seat ``u0..u0 + 0.42`` along wall ``side``.
+
+    Parameters
+    ----------
+    b : Builder
+        The scene's builder.
+    room : Room
+        The room.
+    side : str
+        The wall it stands along.
+    u0, d0 : float
+        The seat's corner nearest the wall's left end and the wall (m).
+    facing : int
+        ``+1``: it faces along the wall to the right (its back at ``u0``), ``-1``: to
+        the left (its back at ``u0 + 0.42``).
+    rgb : sequence of float
+        Its colour.
+    """
+    c = np.asarray(rgb, np.float32)
+    s, t = 0.42, 0.035
+    ub = u0 if facing > 0 else u0 + s - t  # the back's side
+    uf = u0 + s - t if facing > 0 else u0  # the front's side
+    parts = [room.box(side, u0, u0 + s, d0, d0 + s, 0.42, 0.46, c)]
+    for dd in (d0, d0 + s - t):
+        parts.append(room.box(side, uf, uf + t, dd, dd + t, 0.0, 0.42, c * 0.85))
+        parts.append(room.box(side, ub, ub + t, dd, dd + t, 0.0, 0.9, c * 0.85))
+    parts.append(room.box(side, ub, ub + t, d0, d0 + s, 0.68, 0.88, c))
+    b.solid(parts)
+
+
+def dining_table(
+    b: Builder,
+    room: Room,
+    side: str,
+    u0: float,
+    width: float = 1.2,
+    depth: float = 0.8,
+    wood: RGB = (196, 164, 122),
+    chairs: RGB | None = None,
+) -> None:
+    """A table pushed against wall ``side`` with a chair at each end (along the wall).
+
+    The table stands from ``u0`` to ``u0 + width``, the chairs 5 cm beyond its ends, so
+    the whole set spans ``u0 - 0.47 .. u0 + width + 0.47`` and stays within ``depth``
+    of the wall.
+
+    Parameters
+    ----------
+    b : Builder
+        The scene's builder.
+    room : Room
+        The room.
+    side : str
+        The wall it stands against.
+    u0 : float
+        The table's left end along the wall (m).
+    width, depth : float
+        The table's size (m).
+    wood : sequence of float
+        Colour of the table.
+    chairs : sequence of float, optional
+        Colour of the chairs (default: the table's).
+    """
+    w = np.asarray(wood, np.float32)
+    top, leg = 0.75, 0.06
+    parts = [room.box(side, u0, u0 + width, 0.0, depth, top - 0.035, top, w)]
+    for uu in (u0 + 0.04, u0 + width - 0.04 - leg):
+        for dd in (0.04, depth - 0.04 - leg):
+            parts.append(room.box(side, uu, uu + leg, dd, dd + leg, 0.0, top - 0.035, w * 0.9))
+    b.solid(parts)
+    room.walls[side].take(u0, u0 + width, 0.0, top)
+    chair_rgb = w if chairs is None else chairs
+    dc = depth / 2 - 0.21
+    dining_chair(b, room, side, u0 - 0.47, dc, 1, chair_rgb)
+    dining_chair(b, room, side, u0 + width + 0.05, dc, -1, chair_rgb)
 
 
 def floor_lamp(b: Builder, room: Room, side: str, u: float, d: float) -> None:
