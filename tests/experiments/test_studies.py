@@ -54,11 +54,13 @@ def test_every_experiment_is_tested_end_to_end():
     # the paper report runs ORDER; the others have end-to-end tests of their own (agents:
     # tests/training/test_training.py, it needs a trained model; real-rotation and
     # synthetic-compass: tests/test_cli.py; calibration:
-    # tests/experiments/studies/test_calibration.py)
+    # tests/experiments/studies/test_calibration.py; tracking:
+    # tests/experiments/studies/test_tracking_study.py)
     expected = {
         *ORDER,
         "paper",
         "localization",
+        "tracking",
         "agents",
         "real-rotation",
         "synthetic-compass",

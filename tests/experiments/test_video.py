@@ -10,7 +10,13 @@ import numpy as np
 import pytest
 
 from vc_gym.experiments.episode import EpisodeStep, make_homing_run, run_episode
-from vc_gym.experiments.video import ESTIMATE_RGB, TRUE_RGB, EpisodeVideo, write_episode_video
+from vc_gym.experiments.video import (
+    ESTIMATE_RGB,
+    PARTICLE_RGB,
+    TRUE_RGB,
+    EpisodeVideo,
+    write_episode_video,
+)
 
 SHORT = {"learn_time_s": 0.3, "max_homing_s": 3.0}
 POSE = {"pose": (1.5, -0.8, 30.0)}  # kidnapped well away from home
@@ -151,6 +157,33 @@ def test_bad_arguments(run, tmp_path):
         EpisodeVideo(tmp_path / "ep.mp4", run.env, fps=0.0)
     with pytest.raises(ValueError, match="LearnThenHome"):
         EpisodeVideo(tmp_path / "ep.mp4", _NotAnEnv())
+    assert list(tmp_path.iterdir()) == []
+
+
+class _Cloud:
+    """A tracker double that only has particles."""
+
+    particles = np.array([[1.5, 1.0, 0.0]] * 20 + [[-1.5, -1.0, 90.0]] * 20)
+
+
+def test_a_room_video_draws_the_trackers_particles_and_a_new_trail_after_a_jump(tmp_path):
+    from vc_gym.sim import AiboRoomEnv
+
+    room = AiboRoomEnv()
+    try:
+        obs, info = room.reset(seed=0, options={"pose": (0.0, 0.0, 0.0)})
+        video = EpisodeVideo(tmp_path / "room.mp4", room, tracker=_Cloud(), spots={"a": (2, 0)})
+        est = {"heading_deg": 10.0, "position": [0.5, 0.0], "position_std_m": [0.1, 0.1]}
+        frame = video.render(EpisodeStep(0, 0.0, obs, info, tuple(info["pose"]), est))
+        for x, y in ((1.5, 1.0), (-1.5, -1.0)):
+            u, v = video.top_view.to_px(x, y)
+            assert near(frame[v, u], PARTICLE_RGB)
+        obs, info = room.reset(seed=1, options={"pose": (2.0, 1.0, 0.0)})  # teleported
+        video.render(EpisodeStep(1, 0.1, obs, info, tuple(info["pose"]), est))
+        assert len(video._true_trail) == 1  # the trail starts anew where it was put
+        video.abort()
+    finally:
+        room.close()
     assert list(tmp_path.iterdir()) == []
 
 

@@ -172,10 +172,7 @@ def check_demo_args(
 
 
 def _plot(path: Path, record: EpisodeRecord, learned: LearningResult, top: TopView) -> None:
-    # world extent of the top view at floor level
-    half = (top.size / 2.0) / top.focal * 40.0
-    cx, cy = top.center
-    extent = (cx - half, cx + half, cy - half, cy + half)
+    extent = top.extent  # the floor the top view shows
     fig = new_figure(figsize=(13, 6), layout="constrained")
     ax, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.2]})
     ax.imshow(top.background, extent=extent, alpha=0.85)

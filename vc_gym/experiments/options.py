@@ -33,11 +33,14 @@ from vc_gym.validation import (
 __all__ = [
     "HOMING_MODE_CHOICES",
     "HOMING_MODE_HELP",
+    "MAX_LIGHTS",
     "MAX_VIDEOS",
     "OPTIONS",
     "Option",
     "check_folder",
+    "check_light_list",
     "check_seed_list",
+    "parse_float_list",
     "parse_float_pair",
     "parse_int_list",
     "parse_str_list",
@@ -46,6 +49,8 @@ __all__ = [
 
 #: Most homing episodes written as MP4 (``--video``).
 MAX_VIDEOS = 1_000
+#: Most light levels one run compares (``--lights``).
+MAX_LIGHTS = 10
 #: The values ``--mode`` takes: the homing modes and a deprecated name.
 HOMING_MODE_CHOICES = ("check-home", "paper", "improved")
 HOMING_MODE_HELP = (
@@ -76,6 +81,14 @@ def parse_int_list(text: str) -> list[int]:
         return [int(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise ValueError(f"expected integers separated by commas: {text!r}") from None
+
+
+def parse_float_list(text: str) -> list[float]:
+    """``"1,0.5"`` -> ``[1.0, 0.5]`` (empty items are skipped)."""
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(f"expected numbers separated by commas: {text!r}") from None
 
 
 def parse_float_pair(text: str) -> list[float]:
@@ -167,6 +180,15 @@ def _max_homing(flag: str, value: float) -> None:
 
 def _videos(flag: str, value: int) -> None:
     int_in_range(flag, value, 0, MAX_VIDEOS)
+
+
+def check_light_list(flag: str, values: Sequence[float]) -> None:
+    """1 to :data:`MAX_LIGHTS` distinct light levels, each in ``(0, 1]``."""
+    if not 1 <= len(values) <= MAX_LIGHTS or len(set(values)) != len(values):
+        raise ValueError(f"{flag} must name 1..{MAX_LIGHTS} distinct light levels, got {values}")
+    for v in values:
+        if not 0.0 < v <= 1.0:
+            raise ValueError(f"{flag}: every light level must be in (0, 1], got {v:g}")
 
 
 _TRACKER_KINDS = "grid, particle, kalman, 'package.module:factory' or a JSON object"
@@ -294,6 +316,15 @@ OPTIONS: dict[str, Option] = {
         "paper's 5.3: 0.5)",
         parse=float,
         metavar="L",
+    ),
+    "lights": Option(
+        "lights",
+        "--lights",
+        "room illuminations to compare, each in (0, 1] (maps learned at full light; the "
+        "paper's 5.3: 0.5), e.g. --lights 1,0.5",
+        parse=parse_float_list,
+        metavar="L,L,...",
+        check=check_light_list,
     ),
     "data_dir": Option(
         "data_dir",

@@ -6,7 +6,10 @@ Each frame shows the robot's head-camera image beside a top view of the scene
 heading arrow, the camera's field of view, orange trail), the tracker's estimated pose
 (cyan ring with a heading arrow, its 1σ position uncertainty as an ellipse, cyan trail),
 home and the training spots, above a caption with the time, the heading error and the
-distance from home. :func:`write_episode_video` runs one episode with it.
+distance from home (in a room without a home, the position error). Given the tracker,
+it also draws the tracker's ``particles`` when it has them (magenta dots). A true pose
+that jumps (a kidnapping in the middle of a recording) starts the true trail anew.
+:func:`write_episode_video` runs one episode with it.
 
 The file is written through a temporary file in the same folder and renamed into place
 when the video is closed, so ``path`` holds a whole video or none.
@@ -17,6 +20,7 @@ from __future__ import annotations
 import math
 import os
 import tempfile
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -29,12 +33,14 @@ from vc_gym.experiments.episode import EpisodeRecord, EpisodeStep, HomingRun, ru
 from vc_gym.persistence import write_atomic
 from vc_gym.sim.top_view import TopView
 
-__all__ = ["ESTIMATE_RGB", "TRUE_RGB", "EpisodeVideo", "write_episode_video"]
+__all__ = ["ESTIMATE_RGB", "PARTICLE_RGB", "TRUE_RGB", "EpisodeVideo", "write_episode_video"]
 
 #: Colour of the true robot body (the body :meth:`TopView.draw` fills), RGB.
 TRUE_RGB = (220, 40, 40)
 #: Colour of the estimated pose, its uncertainty and trail, RGB.
 ESTIMATE_RGB = (0, 230, 255)
+#: Colour of a particle tracker's particles, RGB.
+PARTICLE_RGB = (255, 0, 255)
 _TRUE_TRAIL_RGB = (255, 128, 0)  # TopView.draw's trail colour
 _HOME_RGB = (255, 255, 255)
 _SPOT_RGB = (255, 230, 0)
@@ -46,6 +52,9 @@ _CAPTION_PX = 52  # two lines of text
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 _ARROW_M = 0.5
 _RING_PX = 11  # the estimate's ring: a little larger than the 0.45 x 0.3 m body
+_JUMP_M = 0.5  # a true pose that moves farther in one step was teleported
+_MAX_PARTICLES = 1000  # most particles drawn (every k-th)
+_MAX_SPOT_LABELS = 8  # more spots are marked without their names
 
 
 def _even(n: int) -> int:
@@ -77,6 +86,12 @@ class EpisodeVideo:
         learned, ``learning_result`` or ``atlas``) or a ``vc_gym/AiboRoom-v0``.
     fps : float, optional
         Frames per second of the video. Default ``1 / control_dt``: real time.
+    tracker : object, optional
+        The tracker whose belief is shown: its ``particles`` (an ``(N, 3)`` array of
+        ``x, y, θ``, world frame), if it has them, are drawn in every frame.
+    spots : mapping, optional
+        ``{name: (x, y)}`` of the training spots to mark (default: the task's learned
+        spots; none for a room).
 
     Raises
     ------
@@ -84,7 +99,15 @@ class EpisodeVideo:
         If OpenCV cannot write ``mp4v`` MP4 files (a build without video I/O).
     """
 
-    def __init__(self, path: str | os.PathLike, env: gym.Env, fps: float | None = None):
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        env: gym.Env,
+        fps: float | None = None,
+        *,
+        tracker: object | None = None,
+        spots: Mapping[str, Sequence[float]] | None = None,
+    ):
         u = env.unwrapped
         room = getattr(u, "room", u)
         if not all(hasattr(room, a) for a in ("client", "scene", "camera", "head_image")):
@@ -101,6 +124,10 @@ class EpisodeVideo:
         self.fps = fps
         self._task = u
         self._room = room
+        self._tracker = tracker
+        self._given_spots = (
+            None if spots is None else {str(n): (float(x), float(y)) for n, (x, y) in spots.items()}
+        )
         cam_w = round(room.camera.width * _TOP_PX / room.camera.height)
         self._cam_size = (cam_w, _TOP_PX)
         #: ``(width, height)`` of every frame, pixels
@@ -178,16 +205,25 @@ class EpisodeVideo:
                     robot.set_visible(True)
         top = self.top_view
         x, y, yaw = step.true_pose
+        if self._true_trail and math.dist(self._true_trail[-1], (x, y)) > _JUMP_M:
+            self._true_trail = []  # teleported: a new trail
         self._true_trail.append((x, y))
         pan = float(step.info.get("head", (0.0,))[0])
         img = top.draw(
             x, y, yaw, yaw + pan, self._room.camera.hfov_deg, trail=np.array(self._true_trail)
         )
         px_per_m = (top.to_px(top.center[0] + 10.0, 0.0)[0] - top.to_px(top.center[0], 0.0)[0]) / 10
-        for name, (sx, sy) in self._spots().items():
+        spots = self._spots()
+        for name, (sx, sy) in spots.items():
             p = top.to_px(sx, sy)
             cv2.drawMarker(img, p, _SPOT_RGB, cv2.MARKER_TILTED_CROSS, 10, 2, cv2.LINE_AA)
-            _text(img, name, (p[0] + 6, p[1] - 6), _SPOT_RGB, 0.35)
+            if len(spots) <= _MAX_SPOT_LABELS:
+                _text(img, name, (p[0] + 6, p[1] - 6), _SPOT_RGB, 0.35)
+        particles = self._particles()
+        if particles is not None:
+            every = max(1, math.ceil(len(particles) / _MAX_PARTICLES))
+            for px, py in particles[::every, :2]:
+                cv2.circle(img, top.to_px(px, py), 1, PARTICLE_RGB, -1)
         home = getattr(self._task, "home", None)
         if home is not None:
             cv2.drawMarker(img, top.to_px(*home), _HOME_RGB, cv2.MARKER_CROSS, 16, 2, cv2.LINE_AA)
@@ -211,7 +247,20 @@ class EpisodeVideo:
         _text(img, "top view (north up)", (8, 18), box=True)
         return img
 
+    def _particles(self) -> np.ndarray | None:
+        """The tracker's particles ``(N, >= 2)``, or ``None`` (no tracker, none, or not
+        finite)."""
+        p = getattr(self._tracker, "particles", None)
+        if p is None:
+            return None
+        p = np.asarray(p, np.float64)
+        if p.ndim != 2 or p.shape[1] < 2 or not np.all(np.isfinite(p[:, :2])):
+            return None
+        return p
+
     def _spots(self) -> dict[str, tuple[float, float]]:
+        if self._given_spots is not None:
+            return dict(self._given_spots)
         learned = getattr(self._task, "learning_result", None)
         if learned is not None:
             return dict(learned.spots)
@@ -223,17 +272,26 @@ class EpisodeVideo:
     def _caption(self, frame: np.ndarray, step: EpisodeStep) -> None:
         info: dict[str, Any] = step.info
         x, y, yaw = step.true_pose
-        home = getattr(self._task, "home", (0.0, 0.0))
-        dist = math.hypot(x - home[0], y - home[1])
+        home = getattr(self._task, "home", None)
         est = step.estimate
         if est is None:
             belief = "no estimate"
         else:
             err = float(wrap180(float(est["heading_deg"]) - yaw))
             ex, ey = (float(v) for v in est["position"])
-            believed = math.hypot(ex - home[0], ey - home[1])
-            belief = f"heading error {err:+6.1f} deg | believed {believed:4.2f} m from home"
-        line = f"t {step.sim_time_s:5.1f} s | {dist:4.2f} m from home | {belief}"
+            belief = f"heading error {err:+6.1f} deg"
+            if home is None:
+                belief += f" | position error {math.hypot(ex - x, ey - y):4.2f} m"
+            else:
+                believed = math.hypot(ex - home[0], ey - home[1])
+                belief += f" | believed {believed:4.2f} m from home"
+        if home is None:  # a room: no home to be far from
+            line = f"t {step.sim_time_s:5.1f} s | {belief}"
+        else:
+            dist = math.hypot(x - home[0], y - home[1])
+            line = f"t {step.sim_time_s:5.1f} s | {dist:4.2f} m from home | {belief}"
+        if "kidnapped_at_s" in info:
+            line += f" | kidnapped at {float(info['kidnapped_at_s']):.1f} s"
         if "stop_error_m" in info:
             if info.get("fallen"):
                 end = "FELL"
@@ -250,8 +308,12 @@ class EpisodeVideo:
         xl = _text(frame, "true pose", (xl + 20, yl)) + 16
         cv2.circle(frame, (xl + 7, yl - 5), 6, ESTIMATE_RGB, 2, cv2.LINE_AA)
         xl = _text(frame, "estimate (ellipse: 1 sigma)", (xl + 20, yl)) + 16
-        cv2.drawMarker(frame, (xl + 7, yl - 5), _HOME_RGB, cv2.MARKER_CROSS, 12, 2)
-        xl = _text(frame, "home", (xl + 18, yl)) + 16
+        if home is not None:
+            cv2.drawMarker(frame, (xl + 7, yl - 5), _HOME_RGB, cv2.MARKER_CROSS, 12, 2)
+            xl = _text(frame, "home", (xl + 18, yl)) + 16
+        if self._particles() is not None:
+            cv2.circle(frame, (xl + 7, yl - 5), 2, PARTICLE_RGB, -1)
+            xl = _text(frame, "particles", (xl + 16, yl)) + 16
         cv2.drawMarker(frame, (xl + 7, yl - 5), _SPOT_RGB, cv2.MARKER_TILTED_CROSS, 10, 2)
         xl = _text(frame, "training spots", (xl + 18, yl)) + 16
         cv2.line(frame, (xl, yl - 5), (xl + 14, yl - 5), _TRUE_TRAIL_RGB, 2)

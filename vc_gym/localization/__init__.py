@@ -12,7 +12,9 @@ Every tracker satisfies :class:`Tracker`: ``reset(atlas, camera, dt_s)`` and
 * :class:`ParticleTracker` -- particles over ``(x, y, θ)`` weighted by the atlas and
   the compass, with injection so a kidnapping is recovered;
 * :class:`KalmanTracker` -- an unscented Kalman heading filter and the translational
-  filter.
+  filter;
+* :class:`PoseTracker` -- a pose belief over the whole field: particles weighed by every
+  spot's map re-drawn for their position, sensor resetting when the belief is lost.
 
 Each takes ``shortlist=k`` to score only the ``k`` best-fitting spots between full
 scorings (:class:`SpotShortlist`): an atlas with many spots then costs about ``k``
@@ -50,6 +52,7 @@ from vc_gym.localization.goodness_calibration import (
 from vc_gym.localization.grid_tracker import GridTracker
 from vc_gym.localization.kalman_tracker import KalmanTracker
 from vc_gym.localization.particle_tracker import ParticleTracker
+from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.position import AtlasPositionFilter
 from vc_gym.localization.registry import TRACKERS, TrackerSpec, make_tracker, register_tracker
 from vc_gym.localization.shortlist import SpotShortlist
@@ -66,6 +69,7 @@ __all__ = [
     "GridTracker",
     "KalmanTracker",
     "ParticleTracker",
+    "PoseTracker",
     "SpotShortlist",
     "Tracker",
     "TrackerSpec",

@@ -8,6 +8,7 @@ from typing import Any
 from vc_gym.localization.grid_tracker import GridTracker
 from vc_gym.localization.kalman_tracker import KalmanTracker
 from vc_gym.localization.particle_tracker import ParticleTracker
+from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import Tracker
 from vc_gym.plugins import make_plugin, register_plugin
 
@@ -18,6 +19,7 @@ TRACKERS: dict[str, Callable[..., Tracker]] = {
     "grid": GridTracker,
     "particle": ParticleTracker,
     "kalman": KalmanTracker,
+    "pose": PoseTracker,
 }
 
 TrackerSpec = str | Mapping[str, Any] | Callable[[], Tracker] | Tracker | None
@@ -34,7 +36,8 @@ def make_tracker(spec: TrackerSpec = "grid") -> Tracker:
     Parameters
     ----------
     spec : str, dict, callable or Tracker
-        ``"grid"`` (the paper's filters, default), ``"particle"``, ``"kalman"`` or any
+        ``"grid"`` (the paper's filters, default), ``"particle"``, ``"kalman"``,
+        ``"pose"`` (a pose belief over the whole field on re-drawn maps) or any
         name given to :func:`register_tracker`; ``"package.module:factory"`` (imported,
         then called with no arguments: a spec that survives pickling into worker
         processes and the command line); a dict ``{"type": name, **kwargs}``

@@ -57,6 +57,14 @@ class TopView:
                     bc.changeVisualShape(body, d[1], rgbaColor=list(c))
         self.field_bounds = scene.field_bounds
 
+    @property
+    def extent(self) -> tuple[float, float, float, float]:
+        """``(xmin, xmax, ymin, ymax)`` of the floor the view shows, world metres (for
+        matplotlib's ``imshow(view.background, extent=view.extent)``)."""
+        half = (self.size / 2.0) / self.focal * _HEIGHT_M
+        cx, cy = self.center
+        return (cx - half, cx + half, cy - half, cy + half)
+
     def to_px(self, x: float, y: float, z: float = 0.0) -> tuple[int, int]:
         """Pixel of the world point ``(x, y, z)``."""
         d = _HEIGHT_M - z

@@ -150,6 +150,27 @@ EXPERIMENTS: dict[str, Experiment] = {
             _options("trackers", "scenes", "seeds", "episodes", "mode", "atlas_dir", "video"),
         ),
         Experiment(
+            "tracking",
+            _P + "tracking",
+            "beyond the paper: a robot walking 60 s routes across the whole field (turns on "
+            "the spot, head scanning, kidnapped once mid-route) in every scene at full and "
+            "half light, maps on a grid of spots; each tracker's heading and position error "
+            "after 10 s, time to re-localise after the kidnapping, 2σ coverage of its stated "
+            "uncertainty, errors against time and the belief on the top view",
+            _options(
+                "lights",
+                "learn_time_s",
+                "atlas_dir",
+                trackers="a tracker to compare (repeat the flag; default pose, grid and "
+                "particle): a registered name, 'package.module:factory' or a JSON object",
+                scenes="scenes (default: every registered scene)",
+                seeds="learning seeds (default: three from --seed on, 0,1,2)",
+                episodes="routes per learning seed, each with one kidnapping (default 2)",
+                video="write the first N routes as MP4 (head camera beside the top view, "
+                "true and believed pose, a particle tracker's particles)",
+            ),
+        ),
+        Experiment(
             "localization",
             _P + "localization",
             "beyond the paper (5.2's open problem): maps on a grid of spots, position "

@@ -25,6 +25,7 @@ __all__ = [
     "one_scene",
     "open_run",
     "pick_size",
+    "safe_name",
     "scene_field_bounds",
 ]
 
@@ -130,6 +131,13 @@ def check_scenes(scenes: Sequence[str]) -> list[str]:
     if len(set(out)) != len(out):
         raise ValueError(f"scenes given twice: {out}")
     return out
+
+
+def safe_name(name: str) -> str:
+    """``name`` as part of a job key or file name: letters, digits, ``-_.`` (others
+    become ``_``), at most 40 characters (``"tracker"`` if nothing is left)."""
+    keep = "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+    return keep[:40] or "tracker"
 
 
 def check_tracker_spec(tracker: Any) -> Any:

@@ -29,6 +29,7 @@ from vc_gym.experiments.studies.common import (
     median_timings,
     open_run,
     pick_size,
+    safe_name,
 )
 from vc_gym.experiments.studies.kidnapping import (
     EPISODE_JOB,
@@ -211,7 +212,7 @@ def _homing(run: ExperimentRun, opts, size, named, scenes, seeds, episodes, mode
                     folder = run.out / "videos"
                     folder.mkdir(exist_ok=True)
                     kwargs["video"] = str((folder / f"{len(jobs):03d}.mp4").resolve())
-                key = f"{_safe(name)}-{sc}-seed{s}-episode{i:03d}"
+                key = f"{safe_name(name)}-{sc}-seed{s}-episode{i:03d}"
                 jobs.append(Job(key, EPISODE_JOB, kwargs))
                 where.append((name, sc))
     out: dict[str, dict[str, list]] = {n: {sc: [] for sc in scenes} for n in named}
@@ -219,11 +220,6 @@ def _homing(run: ExperimentRun, opts, size, named, scenes, seeds, episodes, mode
         if o is not None:
             out[name][sc].append(o)
     return out
-
-
-def _safe(name: str) -> str:
-    keep = "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
-    return keep[:40] or "tracker"
 
 
 def _costs(run: ExperimentRun) -> dict[str, float]:
@@ -245,7 +241,7 @@ def run_job_tracker(run: ExperimentRun, key: str) -> str | None:
     """The tracker name of an episode job's key (``<tracker>-<scene>-seed..``)."""
     names = run.settings["trackers"]
     for name in names:
-        if key.startswith(_safe(name) + "-"):
+        if key.startswith(safe_name(name) + "-"):
             return name
     return None
 

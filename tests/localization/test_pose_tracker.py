@@ -1,0 +1,168 @@
+"""PoseTracker: a pose belief over the whole field, on maps re-drawn for each position.
+
+Known answers come from the ray-cast room (:mod:`vc_gym.worlds.room`): a walk with true
+poses, odometry with scale errors and noise, and a kidnapping.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
+from vc_gym.localization import PoseTracker, Tracker, make_tracker
+from vc_gym.worlds.room import make_room, render_room_view
+
+WIDTH_M, DEPTH_M = 5.0, 4.0
+SPOTS = [(x, y) for x in (-1.0, 0.0, 1.0) for y in (-0.75, 0.75)]
+AROUND = {"e": (0.5, 0.0), "w": (-0.5, 0.0), "n": (0.0, 0.5), "s": (0.0, -0.5)}
+YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]
+FIELD = ((-1.6, -1.2), (1.6, 1.2))
+
+
+@pytest.fixture(scope="module")
+def room():
+    return make_room(np.random.default_rng(5), width_m=WIDTH_M, depth_m=DEPTH_M)
+
+
+def _turn(room, x: float, y: float, colors, yaws) -> VisualCompass:
+    vc = VisualCompass(CompassConfig(), colors)
+    if colors is None:
+        vc.fit_colors([render_room_view(room, x, y, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
+    for a in yaws:
+        vc.learn(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+    return vc
+
+
+@pytest.fixture(scope="module")
+def atlas(room):
+    """Six spots 1 m apart, each with four shorter turns 0.5 m around it."""
+    entries, colors = {}, None
+    for i, (x, y) in enumerate(SPOTS):
+        vc = _turn(room, x, y, colors, YAWS)
+        colors = vc.colors
+        entries[f"spot{i}"] = ((x, y), vc)
+        for side, (dx, dy) in AROUND.items():
+            turn = _turn(room, x + dx, y + dy, colors, YAWS[1::3])
+            entries[f"spot{i}.{side}"] = ((x + dx, y + dy), turn)
+    return CompassAtlas(entries, home="spot0")
+
+
+def _walk(room, atlas, tracker, frames: int = 200, kidnap_at: int | None = None, seed: int = 1):
+    """Errors per frame of a walk between random waypoints with the head scanning."""
+    rng = np.random.default_rng(seed)
+    tracker.reset(atlas, Camera(), 0.1)
+    pose = np.array([0.2, -0.3, 30.0])
+    goal = rng.uniform(*FIELD)
+    out = []
+    for f in range(frames):
+        if f == kidnap_at:
+            pose = np.array([*rng.uniform(*FIELD), rng.uniform(0, 360)])
+        d = goal - pose[:2]
+        if math.hypot(*d) < 0.2:
+            goal = rng.uniform(*FIELD)
+            d = goal - pose[:2]
+        err = wrap180(math.degrees(math.atan2(d[1], d[0])) - pose[2])
+        turn = float(np.clip(err, -6.0, 6.0))
+        fwd = 0.04 if abs(err) < 30 else 0.0
+        th = math.radians(pose[2])
+        pose += (fwd * math.cos(th), fwd * math.sin(th), turn)
+        pose[2] %= 360.0
+        pan = 30.0 * math.sin(0.3 * f)
+        image = render_room_view(room, pose[0], pose[1], Camera(yaw_deg=pose[2] + pan))
+        noise = rng.normal(0, (0.002, 0.002, 0.2))
+        odo = (fwd * 1.05 + noise[0], noise[1], turn * 0.97 + noise[2])
+        s = tracker.update(image, pan, odo)
+        ex, ey = s.position[0] - pose[0], s.position[1] - pose[1]
+        heading_error = abs(wrap180(s.heading_deg - pose[2]))
+        out.append((heading_error, math.hypot(ex, ey), s.heading_spread_deg))
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def kidnapped_walk(room, atlas):
+    return _walk(room, atlas, PoseTracker(seed=3), frames=260, kidnap_at=130)
+
+
+def test_it_is_a_named_tracker():
+    assert isinstance(make_tracker("pose"), PoseTracker)
+    assert make_tracker({"type": "pose", "n_particles": 100}).n_particles == 100
+    assert isinstance(PoseTracker(), Tracker)
+
+
+def test_it_tracks_a_walk(kidnapped_walk):
+    settled = kidnapped_walk[50:130]
+    assert np.mean(settled[:, 0]) < 8.0  # degrees
+    assert np.mean(settled[:, 1]) < 0.35  # metres
+
+
+def test_it_finds_the_robot_again_after_a_kidnapping(kidnapped_walk):
+    after = kidnapped_walk[130:]
+    ok = (after[:, 1] < 0.4) & (after[:, 0] < 15.0)
+    # within 5 s (50 frames) the belief is back, and stays mostly right
+    found = next(i for i in range(len(after) - 20) if ok[i : i + 20].mean() >= 0.9)
+    assert found < 50
+    assert np.mean(after[found + 20 :, 1]) < 0.35
+
+
+def test_the_same_seed_gives_the_same_walk(room, atlas):
+    a = _walk(room, atlas, PoseTracker(n_particles=100, seed=4), frames=30)
+    b = _walk(room, atlas, PoseTracker(n_particles=100, seed=4), frames=30)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_particles_and_state(room, atlas):
+    t = PoseTracker(n_particles=64)
+    t.reset(atlas, Camera(), 0.1)
+    s = t.update(render_room_view(room, 0.0, 0.0, Camera(yaw_deg=90.0)), 0.0, (0.0, 0.0, 0.0))
+    assert t.particles.shape == (64, 3) and t.weights.shape == (64,)
+    assert math.isclose(t.weights.sum(), 1.0)
+    assert s.belief.shape == (360,) and math.isclose(s.belief.sum(), 1.0)
+    assert s.goodness.shape == (len(atlas.names),)
+    assert 0.0 <= s.heading_deg < 360.0 and s.heading_spread_deg <= 180.0
+
+
+def test_a_frame_with_nothing_in_view_keeps_the_belief(room, atlas):
+    t = PoseTracker(n_particles=64)
+    t.reset(atlas, Camera(), 0.1)
+    t.update(render_room_view(room, 0.0, 0.0, Camera(yaw_deg=90.0)), 0.0, (0.0, 0.0, 0.0))
+    before = t.particles
+    t.update(np.zeros((160, 208, 3), np.uint8), 0.0, (0.0, 0.0, 0.0))
+    assert np.abs(t.particles[:, :2] - before[:, :2]).max() < 0.2  # motion noise only
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"n_particles": 0}, "n_particles"),
+        ({"temperature": 0}, "temperature"),
+        ({"outlier": 1.0}, "outlier"),
+        ({"motion_noise": (0.1, 0.1)}, "motion_noise"),
+        ({"motion_noise": (0.1, -0.1, 1.0)}, "motion_noise"),
+        ({"rescore_every": 0}, "rescore_every"),
+        ({"reset_fraction": 1.5}, "reset_fraction"),
+        ({"inject_fraction": -0.1}, "inject_fraction"),
+        ({"lost_checks": 0}, "lost_checks"),
+        ({"reset_spread_m": 0}, "reset_spread_m"),
+        ({"margin_m": 1e9}, "margin_m"),
+        ({"light_window": 0}, "light_window"),
+        ({"seed": 1.5}, "seed"),
+        ({"lattice_m": float("nan")}, "lattice_m"),
+    ],
+)
+def test_bad_settings_are_refused(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        PoseTracker(**kwargs)
+
+
+def test_update_before_reset_and_bad_frames_are_refused(room, atlas):
+    with pytest.raises(RuntimeError, match="reset"):
+        PoseTracker().update(np.zeros((160, 208, 3), np.uint8), 0.0, (0, 0, 0))
+    t = PoseTracker(n_particles=16)
+    t.reset(atlas, Camera(), 0.1)
+    with pytest.raises(ValueError, match="odometry"):
+        t.update(np.zeros((160, 208, 3), np.uint8), 0.0, (0, np.nan, 0))
+    with pytest.raises(ValueError):
+        t.update(np.zeros((160, 208), np.uint8), 0.0, (0, 0, 0))
