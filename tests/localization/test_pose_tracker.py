@@ -133,6 +133,26 @@ def test_a_frame_with_nothing_in_view_keeps_the_belief(room, atlas):
     assert np.abs(t.particles[:, :2] - before[:, :2]).max() < 0.2  # motion noise only
 
 
+def test_the_stated_uncertainty_adds_the_maps_resolution(room, atlas):
+    image = render_room_view(room, 0.3, 0.1, Camera(yaw_deg=60.0))
+    states = {}
+    for r in (0.0, 0.25):
+        t = PoseTracker(n_particles=200, resolution_m=r, resolution_deg=4.0 * r, seed=2)
+        t.reset(atlas, Camera(), 0.1)
+        states[r] = t.update(image, 0.0, (0.0, 0.0, 0.0))
+    bare, stated = states[0.0], states[0.25]
+    assert stated.position == bare.position and stated.heading_deg == bare.heading_deg
+    for b, s in zip(bare.position_std_m, stated.position_std_m, strict=True):
+        assert math.isclose(s, math.hypot(b, 0.25))
+    assert math.isclose(stated.heading_spread_deg, math.hypot(bare.heading_spread_deg, 1.0))
+
+
+@pytest.mark.parametrize("rule", ["nearest", "best2"])
+def test_either_spot_rule_tracks(room, atlas, rule):
+    walk = _walk(room, atlas, PoseTracker(n_particles=200, spot_rule=rule, seed=3), frames=80)
+    assert np.mean(walk[30:, 0]) < 10.0 and np.mean(walk[30:, 1]) < 0.4
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
@@ -150,6 +170,9 @@ def test_a_frame_with_nothing_in_view_keeps_the_belief(room, atlas):
         ({"light_window": 0}, "light_window"),
         ({"seed": 1.5}, "seed"),
         ({"lattice_m": float("nan")}, "lattice_m"),
+        ({"resolution_m": -0.1}, "resolution_m"),
+        ({"resolution_deg": 200.0}, "resolution_deg"),
+        ({"spot_rule": "best"}, "spot_rule"),
     ],
 )
 def test_bad_settings_are_refused(kwargs, match):

@@ -26,7 +26,10 @@ from vc_gym.validation import (
     positive_float,
 )
 
-__all__ = ["PoseTracker"]
+__all__ = ["SPOT_RULES", "PoseTracker"]
+
+#: Which spot's map scores a particle (:class:`PoseTracker` ``spot_rule``).
+SPOT_RULES = ("nearest", "best2")
 
 #: Pose maps built per atlas (learning the wall distances of every spot takes a while):
 #: an env resets its tracker every episode with the same atlas.
@@ -73,6 +76,18 @@ class PoseTracker:
     for several checks running (a kidnapping, or a belief that lost the robot),
     ``reset_fraction`` of the particles are replaced instead.
 
+    Stated uncertainty: the particles' spread plus, in quadrature, the resolution of
+    the maps themselves (``resolution_m``, ``resolution_deg``): the cloud shrinks to
+    what the likelihood can tell apart, but the likelihood of a 4.5° sector histogram
+    does not pin a walking robot's position closer than ~0.2 m nor its heading closer
+    than a few degrees (``scripts/pose_likelihood_diagnostic.py``), and a spread that
+    leaves that out is overconfident.
+
+    Which map scores a particle: ``spot_rule="nearest"`` the map of the spot nearest
+    it; ``"best2"`` the better of its two nearest spots' maps, which smooths the step
+    in the likelihood where the nearest spot changes (each map fits best near its own
+    spot).
+
     Light: with maps learned with ``exposure="session"`` the frames are brought to
     one gain for the run's light (:class:`~vc_gym.exposure.SessionLight`), read from
     the frames so far, instead of one gain per frame.
@@ -102,6 +117,11 @@ class PoseTracker:
         σ of the positions drawn around a spot.
     margin_m : float
         Particles stay within the spots' bounding box grown by this much.
+    resolution_m, resolution_deg : float
+        Added in quadrature to the particles' position std and heading spread in the
+        stated uncertainty.
+    spot_rule : str
+        ``"nearest"`` or ``"best2"``: which spot's map scores a particle.
     lattice_m, reach_m : float
         :class:`~vc_gym.compass.pose_maps.PoseMaps` settings.
     light_window : int
@@ -113,7 +133,7 @@ class PoseTracker:
     def __init__(
         self,
         n_particles: int = 500,
-        temperature: float = 10.0,
+        temperature: float = 40.0,
         outlier: float = 0.02,
         motion_noise: tuple[float, float, float] = (0.01, 0.01, 1.0),
         odometry_noise: float = 0.1,
@@ -124,6 +144,9 @@ class PoseTracker:
         lost_checks: int = 2,
         reset_spread_m: float = 0.35,
         margin_m: float = 1.0,
+        resolution_m: float = 0.25,
+        resolution_deg: float = 4.0,
+        spot_rule: str = "best2",
         lattice_m: float = 0.1,
         reach_m: float = 1.5,
         light_window: int = 100,
@@ -149,6 +172,16 @@ class PoseTracker:
         self.margin_m = nonnegative_float("margin_m", margin_m)
         if self.margin_m > MAX_ABS_METRES or self.reset_spread_m > MAX_ABS_METRES:
             raise ValueError(f"margin_m and reset_spread_m must be at most {MAX_ABS_METRES:g} m")
+        self.resolution_m = nonnegative_float("resolution_m", resolution_m)
+        self.resolution_deg = nonnegative_float("resolution_deg", resolution_deg)
+        if self.resolution_m > MAX_ABS_METRES or self.resolution_deg > 180:
+            raise ValueError(
+                f"resolution_m must be at most {MAX_ABS_METRES:g} m and resolution_deg at "
+                f"most 180°, got {resolution_m!r}, {resolution_deg!r}"
+            )
+        if spot_rule not in SPOT_RULES:
+            raise ValueError(f"spot_rule must be one of {list(SPOT_RULES)}, got {spot_rule!r}")
+        self.spot_rule = spot_rule
         self.lattice_m = positive_float("lattice_m", lattice_m)
         self.reach_m = positive_float("reach_m", reach_m)
         self.light = SessionLight(int_at_least("light_window", light_window, 1))
@@ -214,7 +247,7 @@ class PoseTracker:
             pf.replace(outside, p[outside])
         check = self._fresh or self._frame % self.rescore_every == 0
         self._frame += 1
-        near = self.maps.nearest(p[:, :2])
+        near = self._scoring_spots(p[:, :2])
         spots = None if check else np.unique(near)
         terms = self.maps.frame(image, self.camera, spots, self._gain(image))
         if terms.has_evidence:
@@ -233,11 +266,26 @@ class PoseTracker:
             return None
         return self.light.update(self.maps.maps[0].frame_gain(image, self.camera))
 
+    def _scoring_spots(self, xy: np.ndarray) -> np.ndarray:
+        """``(N, k)`` the spots whose maps may score each position (``spot_rule``)."""
+        if self.spot_rule == "nearest" or len(self.maps) == 1:
+            return self.maps.nearest(xy)[:, None]
+        d = xy[:, None, :] - self.maps.positions[None, :, :]
+        return np.argsort(np.einsum("nmk,nmk->nm", d, d), axis=1)[:, :2]
+
     def _log_likelihood(
         self, terms: FrameTerms, pan: float, near: np.ndarray, poses: np.ndarray
     ) -> np.ndarray:
-        """Tempered log-likelihood of the frame at ``poses`` (body headings)."""
-        ll = self.maps.log_likelihood(terms, poses[:, :2], wrap360(poses[:, 2] + pan), near)
+        """Tempered log-likelihood of the frame at ``poses`` (body headings): the best
+        of the maps of ``near`` (``(N, k)`` spots)."""
+        heading = wrap360(poses[:, 2] + pan)
+        ll = np.max(
+            [
+                self.maps.log_likelihood(terms, poses[:, :2], heading, near[:, j])
+                for j in range(near.shape[1])
+            ],
+            axis=0,
+        )
         return ll / self.temperature
 
     def _weigh(self, terms: FrameTerms, pan: float, near: np.ndarray, check: bool) -> None:
@@ -262,9 +310,10 @@ class PoseTracker:
 
     def _spot_scores(self, terms: FrameTerms) -> np.ndarray:
         """``(n_spots, n_headings)`` tempered log-likelihood at every spot's position."""
-        return np.stack(
-            [self.maps.heading_log_likelihood(terms, s) for s in range(len(self.maps))]
-        ) / self.temperature
+        return (
+            np.stack([self.maps.heading_log_likelihood(terms, s) for s in range(len(self.maps))])
+            / self.temperature
+        )
 
     def _check_lost(self, terms: FrameTerms, pan: float, ll: np.ndarray) -> None:
         """Compare the belief with the best spot: the log of the frame's expected
@@ -298,11 +347,12 @@ class PoseTracker:
         e = pf.estimate()
         th = pf.particles[:, 2]
         belief = np.bincount(np.floor(th).astype(np.int64) % 360, weights=pf.weights, minlength=360)
+        r = self.resolution_m
         return TrackerState(
             heading_deg=float(e.heading_deg) % 360.0,
-            heading_spread_deg=float(min(e.spread_deg, 180.0)),
+            heading_spread_deg=float(min(math.hypot(e.spread_deg, self.resolution_deg), 180.0)),
             position=(e.x, e.y),
-            position_std_m=e.std_xy,
+            position_std_m=(math.hypot(e.std_xy[0], r), math.hypot(e.std_xy[1], r)),
             goodness=np.zeros(len(self.atlas.names)),
             belief=belief / belief.sum(),
             atlas_position=(e.x, e.y),
