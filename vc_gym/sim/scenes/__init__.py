@@ -1,7 +1,7 @@
 """The simulated scenes: a registry of named scene builders, five of them built in.
 
-Built-in scenes (:data:`SCENES`), the paper's robot lab and its "other environments"
-(section 5):
+Built-in scenes (:data:`SCENES`): the paper's robot lab, its "other environments"
+(section 5), and a plain house beyond the paper:
 
 * ``"robolab"``: the UvA Robolab of the paper, a 7 x 7 m room with a 6 x 4 m green
   carpet field, RoboCup goals, tables with computers, windows, shelves, boards and
