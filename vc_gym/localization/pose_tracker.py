@@ -252,7 +252,8 @@ class PoseTracker:
         terms = self.maps.frame(image, self.camera, spots, self._gain(image))
         if terms.has_evidence:
             if self._fresh:
-                pf.replace(np.arange(self.n_particles), self._drawn(terms, pan, self.n_particles))
+                drawn = self._drawn(self._spot_scores(terms), pan, self.n_particles)
+                pf.replace(np.arange(self.n_particles), drawn)
                 self._fresh = False
             else:
                 self._weigh(terms, pan, near, check)
@@ -291,12 +292,13 @@ class PoseTracker:
     def _weigh(self, terms: FrameTerms, pan: float, near: np.ndarray, check: bool) -> None:
         pf = self.filter
         ll = self._log_likelihood(terms, pan, near, pf.particles)
-        if check:
-            self._check_lost(terms, pan, ll)
+        scores = self._spot_scores(terms) if check else None
+        if scores is not None:
+            self._check_lost(scores, ll)
         top = float(ll.max())
         robust = np.log(self.outlier + (1.0 - self.outlier) * np.exp(ll - top))
         pf.update(_Given(robust), None)
-        if check:
+        if scores is not None:
             lost = self._lost_run >= self.lost_checks
             fraction = self.reset_fraction if lost else self.inject_fraction
             if lost:
@@ -306,7 +308,7 @@ class PoseTracker:
                 if pf.ess < self.n_particles:  # weights not uniform: resample first
                     pf.resample()
                 idx = self.rng.choice(self.n_particles, size=n, replace=False)
-                pf.replace(idx, self._drawn(terms, pan, n))
+                pf.replace(idx, self._drawn(scores, pan, n))
 
     def _spot_scores(self, terms: FrameTerms) -> np.ndarray:
         """``(n_spots, n_headings)`` tempered log-likelihood at every spot's position."""
@@ -315,20 +317,20 @@ class PoseTracker:
             / self.temperature
         )
 
-    def _check_lost(self, terms: FrameTerms, pan: float, ll: np.ndarray) -> None:
-        """Compare the belief with the best spot: the log of the frame's expected
-        likelihood under the belief against the best spot's."""
-        del pan
-        best = float(self._spot_scores(terms).max())
+    def _check_lost(self, scores: np.ndarray, ll: np.ndarray) -> None:
+        """Compare the belief with the best spot (``scores``: :meth:`_spot_scores`):
+        the log of the frame's expected likelihood under the belief against the best
+        spot's."""
+        best = float(scores.max())
         logw = self.filter.log_weights
         top = float(np.max(logw + ll))
         belief = top + math.log(float(np.sum(np.exp(logw + ll - top))))
         self.last_gap = best - belief
         self._lost_run = self._lost_run + 1 if self.last_gap > self.lost_nats else 0
 
-    def _drawn(self, terms: FrameTerms, pan: float, k: int) -> np.ndarray:
-        """``k`` body poses drawn from the frame's fit at every spot."""
-        scores = self._spot_scores(terms)  # (spots, headings)
+    def _drawn(self, scores: np.ndarray, pan: float, k: int) -> np.ndarray:
+        """``k`` body poses drawn from the frame's fit at every spot (``scores``:
+        :meth:`_spot_scores`)."""
         top = scores.max(axis=1)
         spot = self.rng.choice(len(top), size=k, p=_softmax(top))
         out = np.empty((k, 3))
