@@ -223,3 +223,21 @@ def test_learn_turn_rejects_colours_of_the_wrong_kind():
     with pytest.raises(ValueError, match="ColorClasses"):
         ScriptedLearner(room, LearningConfig(learn_time_s=0.1)).learn_turn(colors="red")
     env.close()
+
+
+def test_a_walk_that_cannot_arrive_ends_at_the_time_limit():
+    from vc_gym.envs.learning import WALK_LIMIT_S, ScriptedLearner
+    from vc_gym.sim.head_camera import HeadCameraSpec
+
+    room = gym.make(
+        "vc_gym/AiboRoom-v0", camera=HeadCameraSpec(width=52, height=40, hfov_deg=56.9)
+    ).unwrapped
+    room.reset(seed=0, options={"pose": (0.0, 0.0, 0.0)})
+    learner = ScriptedLearner(room)
+    learner._walk_to(20.0, 0.0)  # far beyond the wall: the robot walks into it
+    limit = int(round(WALK_LIMIT_S / room.control_dt))
+    assert learner.unreached == 1
+    assert limit <= learner.steps_taken <= limit + 200  # the last turn may finish
+    learner._walk_to(*learner.belief[:2])  # already there: no step, nothing unreached
+    assert learner.unreached == 1
+    room.close()

@@ -145,6 +145,10 @@ class LearningResult:
 Learner = Callable[..., LearningResult]
 
 
+#: Longest walk to one goal while learning (simulated seconds); then the robot stays put.
+WALK_LIMIT_S = 30.0
+
+
 def paper_spots(spot_distance_m: float) -> dict[str, tuple[float, float]]:
     """The paper's four training spots ``spot_distance_m`` east, north, west and south of
     home (the world origin), by name (5.2)."""
@@ -188,10 +192,15 @@ class ScriptedLearner:
         self.obs: dict | None = None
         self._home_frames: list[np.ndarray] = []  # the first turn's images, at home
         self.info: dict | None = None
+        #: env steps taken so far, and walks that ended before reaching their goal
+        #: (:data:`WALK_LIMIT_S`)
+        self.steps_taken = 0
+        self.unreached = 0
         #: true ``(x, y, yaw)`` of every frame of the last :meth:`learn_turn` (plots only)
         self.turn_path: list[tuple[float, float, float]] = []
 
     def _act(self, forward: float = 0.0, turn: float = 0.0, pan: float = 0.0) -> None:
+        self.steps_taken += 1
         action = self.room.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
         self.obs, _, terminated, _, self.info = self.room.step(action)
         dx, dy, dth = (float(v) for v in self.obs["odometry"])
@@ -224,7 +233,14 @@ class ScriptedLearner:
             self._act(turn=float(np.clip(3.0 * err, -80.0, 80.0)), pan=pan)
 
     def _walk_to(self, x: float, y: float, tol: float = 0.05) -> None:
+        # a walk that has not arrived after WALK_LIMIT_S ends where the robot stands (a
+        # heading belief that never settles, e.g. in a plain room seen by a small
+        # camera, would otherwise turn towards the goal for thousands of steps)
+        limit = self.steps_taken + int(round(WALK_LIMIT_S / self.dt))
         for _ in range(400):
+            if self.steps_taken >= limit:
+                self.unreached += 1
+                return
             dx, dy = x - self.belief[0], y - self.belief[1]
             dist = math.hypot(dx, dy)
             if dist < tol:

@@ -83,6 +83,11 @@ class PoseTracker:
     than a few degrees (``scripts/pose_likelihood_diagnostic.py``), and a spread that
     leaves that out is overconfident.
 
+    Without turns learned around a spot (an atlas learned without ``keep_around``) the
+    spot's map cannot be re-drawn: it scores every position near the spot alike, and
+    the position is known only to the nearest spot's area (about 1 m in ``vc-gym bench
+    trackers``).
+
     Which map scores a particle: ``spot_rule="nearest"`` the map of the spot nearest
     it; ``"best2"`` the better of its two nearest spots' maps, which smooths the step
     in the likelihood where the nearest spot changes (each map fits best near its own

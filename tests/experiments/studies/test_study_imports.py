@@ -1,6 +1,7 @@
 """Studies share helpers through the shared modules only, never through each other.
 
-A study module (``vc_gym/experiments/studies/<name>.py``) may import from the shared
+A study module (``vc_gym/experiments/studies/<name>.py``, or any module of a study
+package ``vc_gym/experiments/studies/<name>/``) may import from the shared
 helper modules (:data:`SHARED`) and from the registry (the package itself, e.g.
 ``get_experiment`` to run another experiment by name), not from a sibling study. The
 ``paper`` study, which runs all the others, may import their ``run_*`` and
@@ -22,7 +23,15 @@ PACKAGE = "vc_gym.experiments.studies"
 SHARED = {"common", "kidnapping", "orientation_grid"}
 #: Studies that may import the runners and summaries of the others.
 RUNS_OTHERS = {"paper"}
-MODULES = sorted(p for p in FOLDER.glob("*.py") if p.stem != "__init__")
+#: Every study's source files: the study modules and the modules of study packages.
+MODULES = sorted(p for p in FOLDER.glob("*.py") if p.stem != "__init__") + sorted(
+    FOLDER.glob("*/*.py")
+)
+
+
+def study_of(path: Path) -> str:
+    """The study a source file belongs to (its package's name inside a study package)."""
+    return path.stem if path.parent == FOLDER else path.parent.name
 
 
 def sibling_imports(source: str, known: set[str]) -> list[tuple[int, str, str]]:
@@ -57,14 +66,14 @@ def violations(name: str, source: str, known: set[str]) -> list[str]:
     return out
 
 
-@pytest.mark.parametrize("path", MODULES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(FOLDER)))
 def test_no_study_imports_from_a_sibling_study(path):
-    known = {p.stem for p in MODULES}
-    assert violations(path.stem, path.read_text(), known) == []
+    known = {study_of(p) for p in MODULES}
+    assert violations(study_of(path), path.read_text(), known) == []
 
 
 def test_the_shared_modules_exist():
-    assert SHARED <= {p.stem for p in MODULES}
+    assert SHARED <= {study_of(p) for p in MODULES}
 
 
 def test_the_checker_catches_every_form_of_sibling_import():

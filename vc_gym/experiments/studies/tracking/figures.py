@@ -196,7 +196,7 @@ def route_figures(
     frames of ``[k, k + 1)`` s, the last one also the route's last frame).
 
     ``frames`` is a
-    :func:`~vc_gym.experiments.studies.tracking_job.route_job`'s ``frames``.
+    :func:`~vc_gym.experiments.studies.tracking.job.route_job`'s ``frames``.
     """
     parts = _route_parts(frames, kidnap_s, settle_s)
     e = parts["errors"]

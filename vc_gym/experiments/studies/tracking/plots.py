@@ -12,12 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from vc_gym.experiments.studies.tracking_figures import (
+from vc_gym.experiments.studies.tracking.figures import (
     RELOCALISED_HEADING_DEG,
     RELOCALISED_POSITION_M,
     frame_errors,
 )
-from vc_gym.experiments.studies.tracking_routes import Route
+from vc_gym.experiments.studies.tracking.routes import Route
 from vc_gym.experiments.views.top_view import field_axes, scene_top_view
 from vc_gym.jobs.output import new_figure, save_figure
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.experiments.studies.tracking_routes import Route, RouteDriver
+from vc_gym.experiments.studies.tracking.routes import Route, RouteDriver
 from vc_gym.jobs.workers import worker_cache
 
 __all__ = ["SNAPSHOT_PARTICLES", "route_job"]

@@ -29,10 +29,10 @@ bins. Milliseconds per update go to ``run.json`` only. Plots: ``errors_<scene>.p
 ellipses, particles of a tracker that has them).
 
 The parts live in modules of their own: the routes and their driver in
-:mod:`~vc_gym.experiments.studies.tracking_routes`, the job that drives one route in
-:mod:`~vc_gym.experiments.studies.tracking_job`, the measures and the pooled figures in
-:mod:`~vc_gym.experiments.studies.tracking_figures`, the plots in
-:mod:`~vc_gym.experiments.studies.tracking_plots`. This module sizes and runs the
+:mod:`~vc_gym.experiments.studies.tracking.routes`, the job that drives one route in
+:mod:`~vc_gym.experiments.studies.tracking.job`, the measures and the pooled figures in
+:mod:`~vc_gym.experiments.studies.tracking.figures`, the plots in
+:mod:`~vc_gym.experiments.studies.tracking.plots`. This module sizes and runs the
 experiment, says its results in a few lines, and re-exports the names of its
 ``__all__`` (the jobs name ``route_job`` here, as ``...studies.tracking:route_job``).
 """
@@ -61,7 +61,7 @@ from vc_gym.experiments.studies.orientation_grid import (
     mode_trackers,
     training_spots,
 )
-from vc_gym.experiments.studies.tracking_figures import (
+from vc_gym.experiments.studies.tracking.figures import (
     RELOCALISED_HEADING_DEG,
     RELOCALISED_HOLD_S,
     RELOCALISED_POSITION_M,
@@ -71,9 +71,9 @@ from vc_gym.experiments.studies.tracking_figures import (
     tracker_summary,
     two_sigma_coverage,
 )
-from vc_gym.experiments.studies.tracking_job import route_job
-from vc_gym.experiments.studies.tracking_plots import plot_belief, plot_errors, snapshot_times
-from vc_gym.experiments.studies.tracking_routes import (
+from vc_gym.experiments.studies.tracking.job import route_job
+from vc_gym.experiments.studies.tracking.plots import plot_belief, plot_errors, snapshot_times
+from vc_gym.experiments.studies.tracking.routes import (
     ARRIVED_M,
     MAX_FORWARD_M_S,
     MAX_TURN_DEG_S,
