@@ -105,6 +105,25 @@ def learned_room_atlas(room: Room, config: CompassConfig | None = None) -> Compa
     return atlas
 
 
+def learned_room_turn(
+    room: Room, x: float, y: float, colors=None, yaws=LEARN_YAWS
+) -> VisualCompass:
+    """A full turn learned at ``(x, y)`` in ``room`` from ``yaws`` (colour classes fitted
+    on that spot's 0-pan views unless ``colors`` are given)."""
+    vc = VisualCompass(CompassConfig(), colors)
+    if colors is None:
+        vc.fit_colors([render_room_view(room, x, y, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
+    for a in yaws:
+        vc.learn(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
+    return vc
+
+
+@pytest.fixture(scope="session")
+def learn_room_turn():
+    """The :func:`learned_room_turn` factory."""
+    return learned_room_turn
+
+
 @pytest.fixture(scope="session")
 def room_atlas(synthetic_room: Room) -> CompassAtlas:
     """The paper's compasses learned at ROOM_SPOTS in :func:`synthetic_room`."""

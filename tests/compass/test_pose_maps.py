@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
+from vc_gym.compass import Camera, CompassAtlas, wrap180
 from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.pose_maps import PoseMaps, around_groups
 from vc_gym.worlds.room import make_room, render_room_view
@@ -17,7 +17,6 @@ from vc_gym.worlds.room import make_room, render_room_view
 WIDTH_M, DEPTH_M = 5.0, 4.0
 SPOTS = {"spot0": (-1.0, 0.0), "spot1": (1.0, 0.0)}
 AROUND = {"e": (0.5, 0.0), "w": (-0.5, 0.0), "n": (0.0, 0.5), "s": (0.0, -0.5)}
-YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]
 
 
 @pytest.fixture(scope="module")
@@ -25,26 +24,20 @@ def room():
     return make_room(np.random.default_rng(5), width_m=WIDTH_M, depth_m=DEPTH_M)
 
 
-def _turn(room, x: float, y: float, colors=None) -> VisualCompass:
-    vc = VisualCompass(CompassConfig(), colors)
-    if colors is None:
-        vc.fit_colors([render_room_view(room, x, y, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
-    for a in YAWS:
-        vc.learn(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
-    return vc
-
-
 @pytest.fixture(scope="module")
-def atlas(room):
+def atlas(room, learn_room_turn):
     """Two spots 2 m apart, each with four turns 0.5 m around it kept of their own."""
     colors = None
     entries = {}
     for name, (x, y) in SPOTS.items():
-        vc = _turn(room, x, y, colors)
+        vc = learn_room_turn(room, x, y, colors)
         colors = vc.colors
         entries[name] = ((x, y), vc)
         for side, (dx, dy) in AROUND.items():
-            entries[f"{name}.{side}"] = ((x + dx, y + dy), _turn(room, x + dx, y + dy, colors))
+            entries[f"{name}.{side}"] = (
+                (x + dx, y + dy),
+                learn_room_turn(room, x + dx, y + dy, colors),
+            )
     return CompassAtlas(entries, home="spot0")
 
 

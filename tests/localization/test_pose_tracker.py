@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
+from vc_gym.compass import Camera, CompassAtlas, wrap180
 from vc_gym.localization import PoseTracker, Tracker, make_tracker
 from vc_gym.worlds.room import make_room, render_room_view
 
@@ -27,25 +27,16 @@ def room():
     return make_room(np.random.default_rng(5), width_m=WIDTH_M, depth_m=DEPTH_M)
 
 
-def _turn(room, x: float, y: float, colors, yaws) -> VisualCompass:
-    vc = VisualCompass(CompassConfig(), colors)
-    if colors is None:
-        vc.fit_colors([render_room_view(room, x, y, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
-    for a in yaws:
-        vc.learn(render_room_view(room, x, y, Camera(yaw_deg=a)), Camera(yaw_deg=a))
-    return vc
-
-
 @pytest.fixture(scope="module")
-def atlas(room):
+def atlas(room, learn_room_turn):
     """Six spots 1 m apart, each with four shorter turns 0.5 m around it."""
     entries, colors = {}, None
     for i, (x, y) in enumerate(SPOTS):
-        vc = _turn(room, x, y, colors, YAWS)
+        vc = learn_room_turn(room, x, y, colors, YAWS)
         colors = vc.colors
         entries[f"spot{i}"] = ((x, y), vc)
         for side, (dx, dy) in AROUND.items():
-            turn = _turn(room, x + dx, y + dy, colors, YAWS[1::3])
+            turn = learn_room_turn(room, x + dx, y + dy, colors, YAWS[1::3])
             entries[f"spot{i}.{side}"] = ((x + dx, y + dy), turn)
     return CompassAtlas(entries, home="spot0")
 

@@ -174,8 +174,17 @@ class PoseMaps:
 
     def nearest(self, xy: np.ndarray) -> np.ndarray:
         """``(N,)`` index of the spot nearest each of ``(N, 2)`` positions."""
+        return np.argmin(self._squared_distances(xy), axis=1)
+
+    def nearest_two(self, xy: np.ndarray) -> np.ndarray:
+        """``(N, 2)`` indices of the two spots nearest each of ``(N, 2)`` positions,
+        nearest first (one column if there is only one spot)."""
+        return np.argsort(self._squared_distances(xy), axis=1)[:, :2]
+
+    def _squared_distances(self, xy: np.ndarray) -> np.ndarray:
+        """``(N, n_spots)`` squared distances of positions from the spots."""
         d = xy[:, None, :] - self.positions[None, :, :]
-        return np.argmin(np.einsum("nmk,nmk->nm", d, d), axis=1)
+        return np.einsum("nmk,nmk->nm", d, d)
 
     def frame(
         self,

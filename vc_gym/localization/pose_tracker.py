@@ -274,10 +274,9 @@ class PoseTracker:
 
     def _scoring_spots(self, xy: np.ndarray) -> np.ndarray:
         """``(N, k)`` the spots whose maps may score each position (``spot_rule``)."""
-        if self.spot_rule == "nearest" or len(self.maps) == 1:
+        if self.spot_rule == "nearest":
             return self.maps.nearest(xy)[:, None]
-        d = xy[:, None, :] - self.maps.positions[None, :, :]
-        return np.argsort(np.einsum("nmk,nmk->nm", d, d), axis=1)[:, :2]
+        return self.maps.nearest_two(xy)
 
     def _log_likelihood(
         self, terms: FrameTerms, pan: float, near: np.ndarray, poses: np.ndarray
