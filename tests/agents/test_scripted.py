@@ -151,6 +151,38 @@ def test_verify_home_at_home_stops_after_one_turn():
     assert len(p.checks) == 1 and np.hypot(world.x, world.y) < 0.05
 
 
+class SureWorld(AliasingWorld):
+    """The aliasing robot whose tracker also states a position standard deviation."""
+
+    def __init__(self, x, y, heading_deg, std_m):
+        super().__init__(x, y, heading_deg)
+        self.std_m = std_m
+
+    def obs(self, odometry=(0.0, 0.0, 0.0)):
+        return {**super().obs(odometry), "position_std": np.array([self.std_m, self.std_m])}
+
+
+def test_a_sure_belief_at_home_stops_without_the_checking_turn():
+    p = policy(settle_time_s=0.0, verify_home=True, sure_std_m=0.3)
+    world = SureWorld(0.02, -0.03, 90.0, std_m=0.25)
+    assert run_until_still(p, world)
+    assert p.phase == "done" and p.checks == []
+    assert world.h == 90.0  # never turned
+
+
+def test_an_unsure_belief_at_home_still_checks():
+    p = policy(settle_time_s=0.0, verify_home=True, sure_std_m=0.3)
+    world = SureWorld(0.02, -0.03, 90.0, std_m=0.5)
+    assert run_until_still(p, world)
+    assert len(p.checks) == 1
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.1, float("nan"), "0.3"])
+def test_sure_std_must_be_a_positive_distance(bad):
+    with pytest.raises(ValueError, match="sure_std_m"):
+        policy(verify_home=True, sure_std_m=bad)
+
+
 @pytest.mark.parametrize(
     "kwargs",
     [

@@ -62,7 +62,11 @@ def test_modes_choose_the_learning_and_the_policy():
     assert homing_mode("paper").policy == {} and homing_mode("paper").learning == {}
     assert homing_mode("check-home").policy == {"verify_home": True}
     assert homing_mode("check-home").learning == {"normalise_at": "start"}
-    assert set(HOMING_MODES) == {"paper", "check-home"}
+    assert set(HOMING_MODES) == {"paper", "check-home", "pose-home"}
+    pose = homing_mode("pose-home")
+    assert pose.tracker == "pose" and pose.learning["around_m"] > 0
+    assert pose.policy["verify_home"] and pose.policy["sure_std_m"] > 0
+    assert homing_mode("paper").tracker == "grid"
     with pytest.warns(DeprecationWarning, match="check-home"):
         assert homing_mode("improved") is HOMING_MODES["check-home"]
     with pytest.raises(ValueError, match="paper"):
@@ -72,6 +76,7 @@ def test_modes_choose_the_learning_and_the_policy():
         policy = run.act.__self__
         assert policy.verify_home and policy.max_verifications == 2
         assert run.env.unwrapped.learn_config.normalise_at == "start"
+        assert type(run.env.get_wrapper_attr("tracker")).__name__ == "GridTracker"
     finally:
         run.close()
 

@@ -73,6 +73,12 @@ class ScriptedHomingPolicy:
         Full turns at most per episode; after the last one the robot stops.
     verify_turn_deg_s : float
         Turn rate of the checking turn.
+    sure_std_m : float, optional
+        With ``verify_home``: when the estimate says home and the tracker's position
+        standard deviation (``position_std`` of the observation, the larger axis) is at
+        most this, the belief is sure and the robot stops without the checking turn.
+        Meant for a tracker whose position belief is honest (the ``pose`` tracker);
+        default ``None``: always check.
     home_offset_m : (float, float)
         The goal, relative to the tracker's home (world frame, metres): the policy walks
         to and stops where the estimate reads this. Default ``(0, 0)``, the paper's. A
@@ -96,6 +102,7 @@ class ScriptedHomingPolicy:
         max_verifications: int = 4,
         verify_turn_deg_s: float = 60.0,
         home_offset_m: tuple[float, float] = (0.0, 0.0),
+        sure_std_m: float | None = None,
     ):
         if not callable(velocity_action):
             raise ValueError(f"velocity_action must be callable, got {velocity_action!r}")
@@ -137,6 +144,7 @@ class ScriptedHomingPolicy:
         self.max_verifications = max_verifications
         self.verify_turn_deg_s = float(verify_turn_deg_s)
         self.home_offset_m = home_offset(home_offset_m)
+        self.sure_std_m = None if sure_std_m is None else positive_float("sure_std_m", sure_std_m)
         self.reset()
 
     @classmethod
@@ -177,6 +185,9 @@ class ScriptedHomingPolicy:
         tol = self.home_tolerance_m
         self._arrived = dist <= (self.rearm_factor if self._arrived else 1.0) * tol
         if self.verify_home and not settling and self._arrived:
+            if self._sure(obs):
+                self.phase = "done"
+                return self._verifying(None)
             return self._start_verification()
         forward, turn = 0.0, 0.0
         if not settling and not self._arrived:
@@ -187,6 +198,12 @@ class ScriptedHomingPolicy:
             self._scan_i = (self._scan_i + 1) % len(pans)
             pan = pans[self._scan_i]
         return self.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
+
+    def _sure(self, obs: dict[str, np.ndarray]) -> bool:
+        """The position belief is sure enough to stop without checking (``sure_std_m``)."""
+        if self.sure_std_m is None:
+            return False
+        return float(np.max(obs["position_std"])) <= self.sure_std_m
 
     def _home_vector(self, obs: dict[str, np.ndarray]) -> tuple[float, float]:
         """The goal in the robot's frame: the home vector moved by ``home_offset_m``."""

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import inspect
 import math
 import os
@@ -141,7 +140,10 @@ class LearnThenHomeEnv(gym.Env):
     arguments); the result is kept as ``learning_result``. ``normalise_at="return"``
     (the paper) normalises the spots after walking back home by odometry;
     ``"start"`` uses the frames of the first turn, taken at the true home (the stops
-    then lose the offset of the walk back's odometry drift). ``learning_seed`` seeds the
+    then lose the offset of the walk back's odometry drift). ``around_m > 0`` also
+    learns turns ``around_m`` around home and every spot, kept as atlas entries of their
+    own (:class:`~vc_gym.envs.learning.LearningConfig`; the atlas then has 25 entries):
+    the input of the ``pose`` tracker. ``learning_seed`` seeds the
     room for the learning phase on its own (default: drawn from the reset seed), so that
     envs reset with different seeds learn the same place the same way.
     ``atlas_file="place.npz"`` keeps the learning phase's atlas in that file: the first
@@ -190,6 +192,7 @@ class LearnThenHomeEnv(gym.Env):
         compass: CompassConfig | None = None,
         learner: Learner | None = None,
         normalise_at: str = "return",
+        around_m: float = 0.0,
         learning_seed: int | None = None,
         atlas_file: str | os.PathLike | None = None,
         place_cache: bool | str | os.PathLike | PlaceCache | None = True,
@@ -256,6 +259,7 @@ class LearnThenHomeEnv(gym.Env):
             learn_time_s=float(learn_time_s),
             compass=compass if compass is not None else CompassConfig(),
             normalise_at=normalise_at,
+            around_m=float(around_m),
         )
         self.stop_time_s = float(stop_time_s)
         self.success_radius_m = float(success_radius_m)
@@ -274,7 +278,7 @@ class LearnThenHomeEnv(gym.Env):
             spec = {
                 "scene": self.room.scene_name,
                 "learner": repr(self.learner),
-                "learning": dataclasses.asdict(self.learn_config),
+                "learning": self.learn_config.to_key(),
                 "learning_seed": learning_seed,
                 "room": {k: repr(v) for k, v in sorted(room_kwargs.items())},
             }
@@ -293,7 +297,9 @@ class LearnThenHomeEnv(gym.Env):
         self.cached_learner: CachedLearner | None = None
         self._room_kwargs = dict(room_kwargs)
         self._seeded = learning_seed is not None
-        self.max_spots = 4 if learning == "scripted" else int(max_spots)
+        # the scripted learning's atlas: four spots, or with turns around them and home 25
+        scripted_spots = 25 if self.learn_config.around_m else 4
+        self.max_spots = scripted_spots if learning == "scripted" else int(max_spots)
         self.spot_radius_m = float(spot_radius_m)
         self.control_dt = self.room.control_dt
         self.camera = self.room.camera
@@ -367,7 +373,7 @@ class LearnThenHomeEnv(gym.Env):
             key = {
                 "scene": self.room.scene_name,
                 "learner": repr(self.learner),
-                "learning": dataclasses.asdict(self.learn_config),
+                "learning": self.learn_config.to_key(),
                 "learning_seed": int(learn_seed),
                 "room": place_key_value(room),
             }

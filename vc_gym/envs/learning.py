@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from tqdm import tqdm
@@ -90,6 +90,14 @@ class LearningConfig:
         home map while it walks between spots (paper 4.2: 0.3 s).
     compass : CompassConfig
         Compass parameters of every map.
+    around_m : float
+        Beyond the paper: with ``around_m > 0`` the robot also walks to the four points
+        ``around_m`` east, north, west and south of home and of every spot and learns a
+        quarter-length turn at each, kept as atlas entries of their own (``home.e``,
+        ``east.n``, ...), and home's own turn becomes the entry ``home``: what a
+        tracker needs to re-draw a spot's map for a nearby position
+        (:class:`~vc_gym.compass.pose_maps.PoseMaps`). Default 0: the paper's four
+        spots. At most half of ``spot_distance_m``.
     """
 
     spot_distance_m: float = 1.0
@@ -99,10 +107,17 @@ class LearningConfig:
     normalise_at: str = "return"
     half_life_s: float = 0.3
     compass: CompassConfig = field(default_factory=CompassConfig)
+    around_m: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("spot_distance_m", "learn_time_s", "half_life_s"):
             positive_float(name, getattr(self, name))
+        nonnegative_float("around_m", self.around_m)
+        if self.around_m > 0.5 * self.spot_distance_m:
+            raise ValueError(
+                f"around_m must be at most half of spot_distance_m ({self.spot_distance_m:g} m)"
+                f", got {self.around_m!r}"
+            )
         if not self.head_scan_deg or any(abs(p) > 90 for p in self.head_scan_deg):
             raise ValueError(
                 f"head_scan_deg must be non-empty pans within ±90°, got {self.head_scan_deg}"
@@ -116,6 +131,14 @@ class LearningConfig:
             raise ValueError(f"normalise_directions must be an int >= 1, got {n!r}")
         if not isinstance(self.compass, CompassConfig):
             raise ValueError(f"compass must be a CompassConfig, got {type(self.compass).__name__}")
+
+    def to_key(self) -> dict:
+        """The fields as plain data, identifying a learned place (atlas files, the place
+        cache); ``around_m`` only when set, so the paper's places keep their keys."""
+        out = asdict(self)
+        if not self.around_m:
+            del out["around_m"]
+        return out
 
 
 @dataclass
@@ -326,7 +349,8 @@ class ScriptedLearner:
         atlas.normalize(imgs, cams)
 
     def learn(self) -> LearningResult:
-        """Learning phase: home turn, four spots, normalisation at home.
+        """Learning phase: home turn, four spots, normalisation at home (with
+        ``around_m``, also the turns around home and every spot).
 
         Raises
         ------
@@ -335,26 +359,29 @@ class ScriptedLearner:
         """
         cfg = self.config
         steps = self.steps_per_direction()
+        around_steps = max(1, steps // 4)
         spots = self.spots()
         path: list[tuple[float, float, float]] = []
         self.learn_turn(steps)
         colors = self.home_compass.colors
-        compasses = {}
+        compasses: dict[str, tuple[tuple[float, float], VisualCompass]] = {}
+        per_spot = 8 * (steps + (4 * around_steps if cfg.around_m else 0))
         bar = tqdm(
-            total=4 * 8 * steps, desc="learn 4 spots", unit="frame", disable=not self.progress
+            total=4 * per_spot + (8 * 4 * around_steps if cfg.around_m else 0),
+            desc="learn 4 spots",
+            unit="frame",
+            disable=not self.progress,
         )
+        if cfg.around_m:
+            compasses["home"] = (HOME, self.home_compass)
+            compasses.update(self._learn_around("home", HOME, colors, around_steps, path, bar))
         for name in SPOT_NAMES:
             self._walk_to(*spots[name])
-            vc = VisualCompass(cfg.compass, colors)
-            for k in range(8):
-                self._turn_to(45.0 * k)
-                for _ in range(steps):
-                    self._act(pan=self._next_pan())
-                    pan = float(self.obs["head"][0])
-                    vc.learn(self.obs["image"], self.camera.replace(yaw_deg=self.belief[2] + pan))
-                    path.append(tuple(float(v) for v in self.info["pose"]))
-                    bar.update()
-            compasses[name] = (spots[name], vc)
+            compasses[name] = (spots[name], self._learn_here(colors, steps, path, bar))
+            if cfg.around_m:
+                compasses.update(
+                    self._learn_around(name, spots[name], colors, around_steps, path, bar)
+                )
         bar.close()
         atlas = CompassAtlas(compasses, home="home", home_position=HOME)
         if cfg.normalise_at == "start":
@@ -365,7 +392,43 @@ class ScriptedLearner:
         else:
             self._walk_to(*HOME)
             self._normalise(atlas)
-        return LearningResult(atlas, spots, path, self.rot_scale)
+        learned = {name: place for name, (place, _) in compasses.items()}
+        return LearningResult(atlas, learned, path, self.rot_scale)
+
+    def _learn_here(self, colors: ColorClasses, steps: int, path: list, bar: tqdm) -> VisualCompass:
+        """The map of where the robot stands: 8 × 45° by its belief, ``steps`` frames
+        each with head scanning (4.3)."""
+        vc = VisualCompass(self.config.compass, colors)
+        for k in range(8):
+            self._turn_to(45.0 * k)
+            for _ in range(steps):
+                self._act(pan=self._next_pan())
+                pan = float(self.obs["head"][0])
+                vc.learn(self.obs["image"], self.camera.replace(yaw_deg=self.belief[2] + pan))
+                path.append(tuple(float(v) for v in self.info["pose"]))
+                bar.update()
+        return vc
+
+    def _learn_around(
+        self,
+        name: str,
+        spot: tuple[float, float],
+        colors: ColorClasses,
+        steps: int,
+        path: list,
+        bar: tqdm,
+    ) -> dict[str, tuple[tuple[float, float], VisualCompass]]:
+        """Turns at the four points ``around_m`` east, north, west and south of
+        ``spot``, walked to in that order, as entries ``NAME.e``, ``NAME.n``, ..."""
+        r = self.config.around_m
+        x, y = spot
+        out = {}
+        for side, (px, py) in zip(
+            "enws", ((x + r, y), (x, y + r), (x - r, y), (x, y - r)), strict=True
+        ):
+            self._walk_to(px, py)
+            out[f"{name}.{side}"] = ((px, py), self._learn_here(colors, steps, path, bar))
+        return out
 
     def _learn_home(self, steps: int, colors: ColorClasses | None = None) -> None:
         """Learn the home map in a full turn and calibrate the odometry's turns.

@@ -34,6 +34,10 @@ __all__ = ["SavedAtlas", "atlas_key", "atlas_spec", "ensure_atlases", "learn_atl
 LEARNERS = ("scripted", "spot", "grid")
 
 
+#: The learning options of ``vc_gym/LearnThenHome-v0`` an atlas spec may set.
+LEARNING_OPTIONS = ("normalise_at", "around_m")
+
+
 def atlas_spec(
     scene: str = "robolab",
     seed: int = 0,
@@ -69,7 +73,7 @@ def atlas_spec(
         Extra ``vc_gym/AiboRoom-v0`` options while learning (e.g. ``illumination``).
     learning : mapping, optional
         Learning options of ``vc_gym/LearnThenHome-v0`` that differ from the paper's
-        (``{"normalise_at": "start"}``).
+        (:data:`LEARNING_OPTIONS`, e.g. ``{"normalise_at": "start"}``).
     spots : sequence of (x, y), optional
         The spots of the ``"grid"`` learner, the first one home.
     around_m : float
@@ -92,9 +96,11 @@ def atlas_spec(
         spots, around_m = [[float(x), float(y)] for x, y in grid.spots], grid.around_m
     config = CompassConfig(**dict(compass or {}))  # validates the fields
     learning = dict(learning or {})
-    unknown = set(learning) - {"normalise_at"}
+    unknown = set(learning) - set(LEARNING_OPTIONS)
     if unknown:
-        raise ValueError(f"unknown learning options {sorted(unknown)}; known: ['normalise_at']")
+        raise ValueError(
+            f"unknown learning options {sorted(unknown)}; known: {list(LEARNING_OPTIONS)}"
+        )
     LearningConfig(learn_time_s=learn_time_s, compass=config, **learning)
     spec = {
         "scene": str(scene),

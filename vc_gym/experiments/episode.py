@@ -174,10 +174,13 @@ class HomingMode:
         (saved with it: ``normalise_at``).
     policy : dict
         Keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`.
+    tracker : str or dict
+        The tracker the mode homes on unless another is given.
     """
 
     learning: dict[str, Any]
     policy: dict[str, Any]
+    tracker: TrackerSpec = "grid"
 
 
 #: The homing modes. ``paper``: the paper's procedure (5.2), normalising the spots
@@ -186,9 +189,21 @@ class HomingMode:
 #: ``check-home`` (the default): normalising with every frame of the first turn, taken at
 #: the true home before the robot moved, and checking with a full turn that the place is
 #: home before stopping (``verify_home``; a single view can alias with home 1-2 m away).
+#: ``pose-home``: check-home's normalisation, with turns learned 0.5 m around home and
+#: every spot (``around_m``) so that the ``pose`` tracker can re-draw the maps for a
+#: position; the robot homes on the pose tracker's belief and stops without the checking
+#: turn when its position standard deviation is at most 0.27 m (``sure_std_m``; the
+#: tracker adds its maps' 0.25 m resolution, so the particles themselves agree within
+#: ~0.1 m); a check that fails walks the checked offset itself (``verify_gain`` 1: the
+#: pose belief's offset does not shrink with distance as eq. 30's does).
 HOMING_MODES: dict[str, HomingMode] = {
     "paper": HomingMode(learning={}, policy={}),
     "check-home": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
+    "pose-home": HomingMode(
+        learning={"normalise_at": "start", "around_m": 0.5},
+        policy={"verify_home": True, "sure_std_m": 0.27, "verify_gain": 1.0},
+        tracker="pose",
+    ),
 }
 #: The homing mode of the demo, ``vc-gym evaluate`` and every experiment unless told.
 DEFAULT_HOMING_MODE = "check-home"
@@ -227,7 +242,7 @@ def homing_mode(mode: str) -> HomingMode:
 
 def make_homing_run(
     agent: str = "scripted",
-    tracker: TrackerSpec = "grid",
+    tracker: TrackerSpec | None = None,
     scene: str = "robolab",
     learn_time_s: float = 5.0,
     success_radius_m: float = 0.3,
@@ -249,8 +264,9 @@ def make_homing_run(
         the path of a learned agent's ``model.zip`` (it runs on the env it was trained
         on, ``vc_gym/Homing-v0``, with the task's 5 s stop rule, its stops checked while
         it stands: :data:`LEARNED_CONFIRM_STOP_M`).
-    tracker : str, dict or callable
-        The tracker (see :func:`vc_gym.localization.make_tracker`).
+    tracker : str, dict or callable, optional
+        The tracker (see :func:`vc_gym.localization.make_tracker`); default the
+        mode's (:attr:`HomingMode.tracker`).
     scene, learn_time_s, success_radius_m, relearn, max_homing_s
         Task arguments (see ``LearnThenHomeEnv``).
     learner : callable, optional
@@ -275,6 +291,7 @@ def make_homing_run(
         that module; :class:`~vc_gym.agents.learned.LearnedHomingAgent`).
     """
     chosen = homing_mode(default_homing_mode(agent) if mode is None else mode)
+    tracker = chosen.tracker if tracker is None else tracker
     policy_kwargs = {**chosen.policy, **(policy or {})}
     task: dict[str, Any] = {
         "scene": scene,

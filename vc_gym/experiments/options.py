@@ -52,12 +52,14 @@ MAX_VIDEOS = 1_000
 #: Most light levels one run compares (``--lights``).
 MAX_LIGHTS = 10
 #: The values ``--mode`` takes: the homing modes and a deprecated name.
-HOMING_MODE_CHOICES = ("check-home", "paper", "improved")
+HOMING_MODE_CHOICES = ("check-home", "paper", "pose-home", "improved")
 HOMING_MODE_HELP = (
     "check-home: the spots normalised with the frames of the first turn at "
     "the true home, and home checked with a full turn before stopping; paper: the "
     "paper's procedure (normalised after walking back home by odometry, stop where "
-    "the estimate says home); improved: deprecated name of check-home"
+    "the estimate says home); pose-home: check-home's learning plus turns 0.5 m around "
+    "home and every spot, homing on the pose tracker, stopping without the checking turn "
+    "when its position is sure; improved: deprecated name of check-home"
 )
 
 
@@ -191,7 +193,7 @@ def check_light_list(flag: str, values: Sequence[float]) -> None:
             raise ValueError(f"{flag}: every light level must be in (0, 1], got {v:g}")
 
 
-_TRACKER_KINDS = "grid, particle, kalman, 'package.module:factory' or a JSON object"
+_TRACKER_KINDS = "grid, particle, kalman, pose, 'package.module:factory' or a JSON object"
 
 #: Every option an experiment can declare, by the name experiments use for it.
 OPTIONS: dict[str, Option] = {
@@ -218,7 +220,7 @@ OPTIONS: dict[str, Option] = {
     "tracker": Option(
         "tracker",
         "--tracker",
-        f"the tracker: {_TRACKER_KINDS} (default grid)",
+        f"the tracker: {_TRACKER_KINDS} (default grid; pose with --mode pose-home)",
         parse=parse_tracker_spec,
         metavar="SPEC",
     ),

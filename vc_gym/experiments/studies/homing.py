@@ -127,7 +127,7 @@ def run_homing(
     out_dir: str | os.PathLike,
     opts: ExperimentOptions | None = None,
     agent: str = "scripted",
-    tracker: Any = "grid",
+    tracker: Any = None,
     seeds: Sequence[int] | None = None,
     episodes: int | None = None,
     scene: str = "robolab",
@@ -151,8 +151,9 @@ def run_homing(
         Seed, size, backend, ``--atlas``, ``--video``, progress.
     agent : str
         ``"scripted"``, ``"pretrained"`` or a learned agent's ``model.zip``.
-    tracker : str or dict
-        The tracker of every episode (a name, ``"module:factory"`` or a dict).
+    tracker : str or dict, optional
+        The tracker of every episode (a name, ``"module:factory"`` or a dict); default
+        the mode's (``grid``; ``pose`` for ``pose-home``).
     seeds : sequence of int, optional
         Learning seeds (default: ``[opts.seed]``); kidnapping ``i`` of seed ``s`` uses
         seed ``s + 1 + i`` (so ``vc-gym demo --seed s`` is its first episode).
@@ -170,8 +171,8 @@ def run_homing(
     field : bool
         Also measure the likelihood field of fig. 5 (right).
     mode : str, optional
-        ``"check-home"`` or ``"paper"`` (:data:`MODES`: how the place is learned and how
-        the scripted agent homes). Default
+        ``"check-home"``, ``"paper"`` or ``"pose-home"`` (:data:`MODES`: how the place
+        is learned, which tracker is the default and how the scripted agent homes). Default
         :func:`~vc_gym.experiments.episode.default_homing_mode`: check-home for the
         scripted agent, paper for a learned one.
     sensor : str, optional
@@ -214,7 +215,7 @@ def run_homing(
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
     mode = canonical_homing_mode(default_homing_mode(agent) if mode is None else mode)
-    tracker = check_tracker_spec(tracker)
+    tracker = check_tracker_spec(MODES[mode].tracker if tracker is None else tracker)
     if sensor is not None:
         sensor = current_sensor_name(sensor)  # a deprecated name warns and is replaced
         grid_options = _sensor_tracker_options(sensor, tracker, relearn)
