@@ -16,6 +16,7 @@ from vc_gym.envs.learning import (
     SpotLearning,
     kidnap_pose,
 )
+from vc_gym.sim.head_camera import HeadCameraSpec
 
 
 def test_loop_closure_calibrates_odometry_turns():
@@ -50,6 +51,9 @@ def test_kidnap_pose_lies_inside_the_margin():
         {"normalise_directions": 2.5},
         {"compass": "fast"},
         {"normalise_at": "home"},
+        {"around_m": -0.1},
+        {"around_m": float("inf")},
+        {"around_m": 0.6},  # beyond half of the 1 m spot distance
     ],
 )
 def test_bad_config(bad):
@@ -180,9 +184,7 @@ def test_grid_learning_can_keep_the_turns_around_as_entries_of_their_own():
     room.reset(seed=0)
     config = LearningConfig(learn_time_s=0.5)
     merged = GridLearning([(0.0, 0.0)], around_m=0.4, around_steps=2)(room, config)
-    kept = GridLearning([(0.0, 0.0)], around_m=0.4, around_steps=2, keep_around=True)(
-        room, config
-    )
+    kept = GridLearning([(0.0, 0.0)], around_m=0.4, around_steps=2, keep_around=True)(room, config)
     env.close()
     atlas = kept.atlas
     assert atlas.names == ("spot0", "spot0.e", "spot0.w", "spot0.n", "spot0.s")
@@ -227,7 +229,6 @@ def test_learn_turn_rejects_colours_of_the_wrong_kind():
 
 def test_a_walk_that_cannot_arrive_ends_at_the_time_limit():
     from vc_gym.envs.learning import WALK_LIMIT_S, ScriptedLearner
-    from vc_gym.sim.head_camera import HeadCameraSpec
 
     room = gym.make(
         "vc_gym/AiboRoom-v0", camera=HeadCameraSpec(width=52, height=40, hfov_deg=56.9)
@@ -241,3 +242,38 @@ def test_a_walk_that_cannot_arrive_ends_at_the_time_limit():
     learner._walk_to(*learner.belief[:2])  # already there: no step, nothing unreached
     assert learner.unreached == 1
     room.close()
+
+
+def test_a_config_keys_its_place_by_turns_around_only_when_set():
+    assert "around_m" not in LearningConfig().to_key()  # the paper's places keep their keys
+    key = LearningConfig(around_m=0.5).to_key()
+    assert key["around_m"] == 0.5 and key["spot_distance_m"] == 1.0
+
+
+@pytest.mark.slow
+def test_learning_with_turns_around_keeps_them_as_entries_the_pose_tracker_uses(tmp_path):
+    from vc_gym.compass.pose_maps import around_groups
+    from vc_gym.envs import CompassObservation
+
+    small = HeadCameraSpec(width=52, height=40, hfov_deg=56.9)
+    kwargs = {"learn_time_s": 0.2, "max_homing_s": 2.0, "camera": small}
+    kwargs.update(around_m=0.5, normalise_at="start", place_cache=tmp_path)
+    env = gym.make("vc_gym/LearnThenHome-v0", **kwargs)
+    env.reset(seed=2)
+    result = env.unwrapped.learning_result
+    env.close()
+    atlas = result.atlas
+    groups = around_groups(atlas.names)
+    assert list(groups) == ["home", "east", "north", "west", "south"]
+    assert all(len(g) == 5 for g in groups.values())  # each spot and its four turns
+    assert set(result.spots) == set(atlas.names)
+    place = dict(zip(atlas.names, atlas.positions.tolist(), strict=True))
+    assert place["home"] == [0.0, 0.0] and place["north.n"] == [0.0, 1.5]
+    assert place["east.s"] == [1.0, -0.5]
+    # a second env loads the place from the cache and homes on the pose tracker
+    again = CompassObservation(gym.make("vc_gym/LearnThenHome-v0", **kwargs), tracker="pose")
+    obs, _ = again.reset(seed=2)
+    assert again.unwrapped.cached_learner.learned is False
+    assert again.unwrapped.atlas.names == atlas.names
+    assert obs["goodness"].shape == (25,) and np.all(np.isfinite(obs["position"]))
+    again.close()

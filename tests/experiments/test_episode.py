@@ -64,8 +64,8 @@ def test_modes_choose_the_learning_and_the_policy():
     assert homing_mode("check-home").learning == {"normalise_at": "start"}
     assert set(HOMING_MODES) == {"paper", "check-home", "pose-home"}
     pose = homing_mode("pose-home")
-    assert pose.tracker == "pose" and pose.learning["around_m"] > 0
-    assert pose.policy["verify_home"] and pose.policy["sure_std_m"] > 0
+    assert pose.tracker == "pose-grid" and pose.learning["around_m"] > 0
+    assert pose.policy["verify_home"]
     assert homing_mode("paper").tracker == "grid"
     with pytest.warns(DeprecationWarning, match="check-home"):
         assert homing_mode("improved") is HOMING_MODES["check-home"]

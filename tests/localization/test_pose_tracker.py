@@ -124,6 +124,16 @@ def test_a_frame_with_nothing_in_view_keeps_the_belief(room, atlas):
     assert np.abs(t.particles[:, :2] - before[:, :2]).max() < 0.2  # motion noise only
 
 
+def test_an_atlas_without_turns_around_its_spots_is_warned_about(atlas):
+    spots = [k for k, n in enumerate(atlas.names) if "." not in n]
+    plain = CompassAtlas(
+        {atlas.names[k]: (tuple(atlas.positions[k]), atlas.compasses[k]) for k in spots},
+        home="spot0",
+    )
+    with pytest.warns(UserWarning, match="no turns learned around its spots"):
+        PoseTracker(n_particles=16).reset(plain, Camera(), 0.1)
+
+
 def test_the_stated_uncertainty_adds_the_maps_resolution(room, atlas):
     image = render_room_view(room, 0.3, 0.1, Camera(yaw_deg=60.0))
     states = {}

@@ -16,6 +16,7 @@ full turn at a single spot, no walking.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
@@ -392,6 +393,14 @@ class ScriptedLearner:
         else:
             self._walk_to(*HOME)
             self._normalise(atlas)
+        if self.unreached:
+            warnings.warn(
+                f"{self.unreached} walk(s) of the learning phase ended after {WALK_LIMIT_S:g} s "
+                "without reaching their goal (a heading belief that never settled); their maps "
+                "were learned where the robot stood, away from the positions the atlas gives",
+                UserWarning,
+                stacklevel=2,
+            )
         learned = {name: place for name, (place, _) in compasses.items()}
         return LearningResult(atlas, learned, path, self.rot_scale)
 

@@ -191,18 +191,18 @@ class HomingMode:
 #: home before stopping (``verify_home``; a single view can alias with home 1-2 m away).
 #: ``pose-home``: check-home's normalisation, with turns learned 0.5 m around home and
 #: every spot (``around_m``) so that the ``pose`` tracker can re-draw the maps for a
-#: position; the robot homes on the pose tracker's belief and stops without the checking
-#: turn when its position standard deviation is at most 0.27 m (``sure_std_m``; the
-#: tracker adds its maps' 0.25 m resolution, so the particles themselves agree within
-#: ~0.1 m); a check that fails walks the checked offset itself (``verify_gain`` 1: the
-#: pose belief's offset does not shrink with distance as eq. 30's does).
+#: position; the robot homes on the ``pose-grid`` tracker (the pose belief away from
+#: home, which does not get stuck where a view aliases with home; the paper's filters
+#: within 0.5 m of it, which answer home exactly there) and checks home with a full turn
+#: as check-home does, walking the checked offset itself (``verify_gain`` 1: the pose
+#: belief's offset does not shrink with distance as eq. 30's does).
 HOMING_MODES: dict[str, HomingMode] = {
     "paper": HomingMode(learning={}, policy={}),
     "check-home": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
     "pose-home": HomingMode(
         learning={"normalise_at": "start", "around_m": 0.5},
-        policy={"verify_home": True, "sure_std_m": 0.27, "verify_gain": 1.0},
-        tracker="pose",
+        policy={"verify_home": True, "verify_gain": 1.0},
+        tracker="pose-grid",
     ),
 }
 #: The homing mode of the demo, ``vc-gym evaluate`` and every experiment unless told.

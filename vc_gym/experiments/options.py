@@ -193,7 +193,9 @@ def check_light_list(flag: str, values: Sequence[float]) -> None:
             raise ValueError(f"{flag}: every light level must be in (0, 1], got {v:g}")
 
 
-_TRACKER_KINDS = "grid, particle, kalman, pose, 'package.module:factory' or a JSON object"
+_TRACKER_KINDS = (
+    "grid, particle, kalman, pose, pose-grid, 'package.module:factory' or a JSON object"
+)
 
 #: Every option an experiment can declare, by the name experiments use for it.
 OPTIONS: dict[str, Option] = {
@@ -220,7 +222,7 @@ OPTIONS: dict[str, Option] = {
     "tracker": Option(
         "tracker",
         "--tracker",
-        f"the tracker: {_TRACKER_KINDS} (default grid; pose with --mode pose-home)",
+        f"the tracker: {_TRACKER_KINDS} (default grid; pose-grid with --mode pose-home)",
         parse=parse_tracker_spec,
         metavar="SPEC",
     ),

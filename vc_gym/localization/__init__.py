@@ -14,7 +14,9 @@ Every tracker satisfies :class:`Tracker`: ``reset(atlas, camera, dt_s)`` and
 * :class:`KalmanTracker` -- an unscented Kalman heading filter and the translational
   filter;
 * :class:`PoseTracker` -- a pose belief over the whole field: particles weighed by every
-  spot's map re-drawn for their position, sensor resetting when the belief is lost.
+  spot's map re-drawn for their position, sensor resetting when the belief is lost;
+* :class:`HomeSwitchTracker` -- the pose tracker's state away from home, the grid
+  tracker's near it (``"pose-grid"``).
 
 Each takes ``shortlist=k`` to score only the ``k`` best-fitting spots between full
 scorings (:class:`SpotShortlist`): an atlas with many spots then costs about ``k``
@@ -50,6 +52,7 @@ from vc_gym.localization.goodness_calibration import (
     locate_by_goodness,
 )
 from vc_gym.localization.grid_tracker import GridTracker
+from vc_gym.localization.home_switch_tracker import HomeSwitchTracker
 from vc_gym.localization.kalman_tracker import KalmanTracker
 from vc_gym.localization.particle_tracker import ParticleTracker
 from vc_gym.localization.pose_tracker import PoseTracker
@@ -67,6 +70,7 @@ __all__ = [
     "CompassHeadingSensor",
     "GoodnessCalibration",
     "GridTracker",
+    "HomeSwitchTracker",
     "KalmanTracker",
     "ParticleTracker",
     "PoseTracker",

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 
 import numpy as np
 
 from vc_gym.angles import wrap360
 from vc_gym.compass import Camera, CompassAtlas
-from vc_gym.compass.pose_maps import FrameTerms, PoseMaps
+from vc_gym.compass.pose_maps import FrameTerms, PoseMaps, around_groups
 from vc_gym.exposure import SessionLight
 from vc_gym.filters import ParticleFilter
 from vc_gym.filters.particle_filter import check_particle_count
@@ -43,6 +44,14 @@ def pose_maps_of(atlas: CompassAtlas, lattice_m: float, reach_m: float) -> PoseM
     built = _POSE_MAPS.setdefault(atlas, {})
     key = (lattice_m, reach_m)
     if key not in built:
+        if all(len(group) == 1 for group in around_groups(atlas.names).values()):
+            warnings.warn(
+                "the atlas has no turns learned around its spots (GridLearning(keep_around="
+                "True), or the task's around_m > 0): the pose tracker then knows a position "
+                "only to the nearest spot's area",
+                UserWarning,
+                stacklevel=3,
+            )
         built[key] = PoseMaps.from_atlas(atlas, lattice_m, reach_m)
     return built[key]
 

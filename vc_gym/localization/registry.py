@@ -6,6 +6,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from vc_gym.localization.grid_tracker import GridTracker
+from vc_gym.localization.home_switch_tracker import HomeSwitchTracker
 from vc_gym.localization.kalman_tracker import KalmanTracker
 from vc_gym.localization.particle_tracker import ParticleTracker
 from vc_gym.localization.pose_tracker import PoseTracker
@@ -20,6 +21,7 @@ TRACKERS: dict[str, Callable[..., Tracker]] = {
     "particle": ParticleTracker,
     "kalman": KalmanTracker,
     "pose": PoseTracker,
+    "pose-grid": HomeSwitchTracker,
 }
 
 TrackerSpec = str | Mapping[str, Any] | Callable[[], Tracker] | Tracker | None
@@ -37,7 +39,8 @@ def make_tracker(spec: TrackerSpec = "grid") -> Tracker:
     ----------
     spec : str, dict, callable or Tracker
         ``"grid"`` (the paper's filters, default), ``"particle"``, ``"kalman"``,
-        ``"pose"`` (a pose belief over the whole field on re-drawn maps) or any
+        ``"pose"`` (a pose belief over the whole field on re-drawn maps),
+        ``"pose-grid"`` (the pose belief away from home, the paper's filters near it) or any
         name given to :func:`register_tracker`; ``"package.module:factory"`` (imported,
         then called with no arguments: a spec that survives pickling into worker
         processes and the command line); a dict ``{"type": name, **kwargs}``

@@ -153,7 +153,7 @@ def run_homing(
         ``"scripted"``, ``"pretrained"`` or a learned agent's ``model.zip``.
     tracker : str or dict, optional
         The tracker of every episode (a name, ``"module:factory"`` or a dict); default
-        the mode's (``grid``; ``pose`` for ``pose-home``).
+        the mode's (``grid``; ``pose-grid`` for ``pose-home``).
     seeds : sequence of int, optional
         Learning seeds (default: ``[opts.seed]``); kidnapping ``i`` of seed ``s`` uses
         seed ``s + 1 + i`` (so ``vc-gym demo --seed s`` is its first episode).
