@@ -144,6 +144,23 @@ def test_a_subset_of_spots_equals_their_part_of_the_full_answer(atlas, room):
     assert whole.position == everything.position and whole.goodness == everything.goodness
 
 
+def test_the_atlas_of_some_spots_scores_and_normalises_them_as_the_whole_did(atlas, room):
+    image = render_room_view(room, 0.4, -0.3, Camera(yaw_deg=120.0))
+    names = ["west", "east"]
+    part = atlas.subset(names)
+    assert part.names == tuple(names) and part.is_normalized
+    assert part.home_position == atlas.home_position and part.sharpness == atlas.sharpness
+    whole = atlas.estimate_position(image, Camera(), spots=[atlas.names.index(n) for n in names])
+    est = part.estimate_position(image, Camera())
+    assert est.goodness == whole.goodness and est.position == whole.position
+
+
+@pytest.mark.parametrize("names", [[], ["east", "east"], ["home"], "east"])
+def test_a_subset_names_distinct_spots_of_the_atlas(atlas, names):
+    with pytest.raises(ValueError, match="subset"):
+        atlas.subset(names)
+
+
 @pytest.mark.parametrize("spots", [[], [0, 0], [-1], [99], [0.5], "ab", [[0, 1]]])
 def test_bad_spot_subsets_are_refused(atlas, room, spots):
     image = render_room_view(room, 0.0, 0.0, Camera())

@@ -44,8 +44,11 @@ def walk(room, illumination: float = 1.0):
 
 #: The trackers that score the atlas' spots (eq. 28: goodness per spot, a shortlist of
 #: spots, the session light kept by their SpotShortlist); the pose tracker scores poses
-#: on maps re-drawn for them instead (tests/localization/test_pose_tracker.py).
-SPOT_SCORING = sorted(set(TRACKERS) - {"pose"})
+#: on maps re-drawn for them instead (tests/localization/test_pose_tracker.py), and
+#: pose-grid answers with either (tests/localization/test_home_switch_tracker.py).
+SPOT_SCORING = sorted(set(TRACKERS) - {"pose", "pose-grid"})
+#: The trackers whose state holds the frame's goodness of every spot.
+GOODNESS = sorted(set(TRACKERS) - {"pose"})
 
 
 @pytest.fixture(scope="module")
@@ -71,7 +74,7 @@ def test_tracker_follows_the_walk(name, room_atlas, frames):
     peak = 360.0 * np.argmax(last.belief) / last.belief.size
     assert abs(wrap180(peak - true[2])) < 15.0
     assert last.goodness.shape == (4,)
-    assert np.all(last.goodness > 0) == (name in SPOT_SCORING)
+    assert np.all(last.goodness > 0) == (name in GOODNESS)
     assert all(math.isfinite(v) and v >= 0 for v in last.position_std_m)
     # the atlas position is coarse (paper 5.2: ~0.3 m)
     x, y = last.position
@@ -139,13 +142,17 @@ def test_trackers_keep_the_session_light_of_a_session_atlas(
     tracker = make_tracker(name)
     dark = walk(synthetic_room, illumination=0.5)
     states = run(tracker, session_atlas, dark)
-    light = tracker.light if name == "pose" else tracker.spots.light
-    assert light.gain == 2.0 and len(light) == len(dark)
+    lights = {
+        "pose": lambda t: [t.light],
+        "pose-grid": lambda t: [t.far.light, t.near.spots.light],
+    }.get(name, lambda t: [t.spots.light])(tracker)
+    for light in lights:
+        assert light.gain == 2.0 and len(light) == len(dark)
     if name != "kalman":  # Kalman relocks slowly: ~20° off at this short walk's end
         _, _, true = dark[-1]
         assert abs(wrap180(states[-1].heading_deg - true[2])) < 10.0
     tracker.reset(session_atlas, Camera(), 0.1)
-    assert len(light) == 0 and light.gain == 1.0
+    assert all(len(light) == 0 and light.gain == 1.0 for light in lights)
 
 
 def test_particle_tracker_is_reproducible_and_recovers(room_atlas, frames):

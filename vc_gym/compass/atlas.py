@@ -179,6 +179,38 @@ class CompassAtlas:
     def __len__(self) -> int:
         return len(self.names)
 
+    def subset(self, names: Sequence[str]) -> CompassAtlas:
+        """The atlas of the spots ``names`` only (in that order), with the same home,
+        sharpness and normalisation: each kept spot scores a frame, and is normalised,
+        exactly as in this atlas.
+
+        Raises
+        ------
+        ValueError
+            If ``names`` is empty, repeats a spot or names one this atlas lacks.
+        """
+        names = [str(n) for n in names]
+        unknown = sorted(set(names) - set(self.names))
+        if not names or unknown or len(set(names)) != len(names):
+            raise ValueError(
+                f"subset needs distinct spots of the atlas {list(self.names)}, got {names}"
+            )
+        index = [self.names.index(n) for n in names]
+        out = CompassAtlas(
+            {
+                n: (tuple(self.positions[k]), self.compasses[k])
+                for n, k in zip(names, index, strict=True)
+            },
+            home=self.home,
+            home_position=self.home_position,
+            sharpness=self.sharpness,
+        )
+        out._home_scores = self._home_scores[:, index].copy()
+        out._home_headings = self._home_headings[:, index].copy()
+        out._kappa = self._kappa
+        out.is_normalized = self.is_normalized
+        return out
+
     def scores(
         self,
         image: np.ndarray,

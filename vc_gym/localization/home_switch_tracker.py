@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.compass.pose_maps import around_groups
 from vc_gym.localization.grid_tracker import GridTracker
 from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import Tracker, TrackerState, check_reset_inputs
@@ -20,13 +22,20 @@ class HomeSwitchTracker:
     else the state of ``near`` (beyond the paper).
 
     Both trackers get every frame, so each keeps its own belief and the switch costs
-    nothing but the two updates. The defaults pair the trackers by what each does
-    best in the homing task: the ``pose`` tracker (:class:`PoseTracker`) keeps a
-    position over the whole field and does not get stuck where one spot's view
-    aliases with home, but tells a position only to ~0.2 m; the paper's filters
-    (:class:`GridTracker`, eq. 23-32) on an atlas normalised at the true home answer
-    home exactly there (eq. 30: every spot fits equally at the place it was
-    normalised), but shrink a position 1-2 m away towards home.
+    nothing but the two updates. The goodness and the eq. 30 atlas position of the
+    state are always ``near``'s (the frame's own measurements). ``near`` tracks on the
+    atlas' spots without the turns learned around them
+    (:func:`~vc_gym.compass.pose_maps.around_groups`; :meth:`CompassAtlas.subset`): eq.
+    30 over the spots themselves, at the cost of those spots' maps a frame; the turns'
+    goodness reads 0.
+
+    The defaults pair the trackers by what each does best in the homing task: the
+    ``pose`` tracker (:class:`PoseTracker`) keeps a position over the whole field and
+    does not get stuck where one spot's view aliases with home, but tells a position
+    only to ~0.2 m; the paper's filters (:class:`GridTracker`, eq. 23-32) on an atlas
+    normalised at the true home answer home exactly there (eq. 30: every spot fits
+    equally at the place it was normalised), but shrink a position 1-2 m away towards
+    home.
 
     Parameters
     ----------
@@ -57,7 +66,11 @@ class HomeSwitchTracker:
         """Reset both trackers for ``atlas``."""
         check_reset_inputs(atlas, camera, dt_s)
         self.far.reset(atlas, camera, dt_s)
-        self.near.reset(atlas, camera, dt_s)
+        spots = list(around_groups(atlas.names))
+        self.near.reset(atlas if len(spots) == len(atlas) else atlas.subset(spots), camera, dt_s)
+        #: Where each of ``near``'s spots sits in ``atlas.names``.
+        self._spot_index = np.array([atlas.names.index(n) for n in spots])
+        self._n = len(atlas)
         self.home = tuple(float(v) for v in atlas.home_position)
         self.near_home = False
 
@@ -71,4 +84,11 @@ class HomeSwitchTracker:
         near = self.near.update(image, head_pan_deg, odometry)
         x, y = far.position
         self.near_home = math.hypot(x - self.home[0], y - self.home[1]) <= self.switch_m
-        return near if self.near_home else far
+        goodness = np.zeros(self._n)
+        goodness[self._spot_index] = near.goodness
+        # the frame's own measurements (goodness, eq. 30) are ``near``'s either way
+        return dataclasses.replace(
+            near if self.near_home else far,
+            goodness=goodness,
+            atlas_position=near.atlas_position,
+        )
