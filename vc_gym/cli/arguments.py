@@ -53,15 +53,17 @@ def add_option(parser: argparse.ArgumentParser, option: Option) -> None:
 
 
 def add_tracker_option(parser: argparse.ArgumentParser) -> None:
-    """``--tracker SPEC`` with default ``grid``."""
+    """``--tracker SPEC``; default the homing mode's (``grid``; ``pose-grid`` for
+    ``pose-home``)."""
     parser.add_argument(
         "--tracker",
-        default="grid",
+        default=None,
         type=argument_type(parse_tracker_spec, "tracker"),
         metavar="SPEC",
         help=(
             "what turns frames and odometry into the pose estimate: grid (the paper's heading "
-            "grid + translational filter, default), particle, kalman, "
+            "grid + translational filter; the default, pose-grid with --mode pose-home), "
+            "particle, kalman, pose, pose-grid, "
             "'package.module:factory' (your own tracker class or factory), or a JSON "
             'object such as \'{"type": "particle", "n_particles": 2000}\''
         ),

@@ -21,6 +21,7 @@ from vc_gym.experiments.episode import (
     HOMING_MODES,
     EpisodeRecord,
     canonical_homing_mode,
+    homing_mode,
     make_homing_run,
     run_episode,
 )
@@ -45,7 +46,7 @@ def run_demo(
     seed: int = 0,
     learn_time_s: float = 5.0,
     success_radius_m: float = 0.3,
-    tracker: TrackerSpec = "grid",
+    tracker: TrackerSpec = None,
     max_homing_s: float = 60.0,
     progress: bool = True,
     mode: str = DEFAULT_HOMING_MODE,
@@ -70,7 +71,8 @@ def run_demo(
     success_radius_m : float
         The episode succeeds if the robot stops within this distance of home.
     tracker : str, dict or callable
-        The tracker (:func:`vc_gym.localization.make_tracker`), default the paper's.
+        The tracker (:func:`vc_gym.localization.make_tracker`); default the mode's
+        (the paper's filters, ``grid``; ``pose-grid`` for ``pose-home``).
     max_homing_s : float
         Homing time limit (at most :data:`~vc_gym.validation.MAX_HOMING_S`).
     progress : bool
@@ -93,6 +95,7 @@ def run_demo(
     """
     check_demo_args(seed, learn_time_s, success_radius_m, tracker, max_homing_s, progress, mode)
     mode = canonical_homing_mode(mode)
+    tracker = homing_mode(mode).tracker if tracker is None else tracker
     with new_out_dir(out_dir) as out:
         t0 = time.perf_counter()
         run = make_homing_run(
@@ -131,7 +134,7 @@ def check_demo_args(
     seed: object = 0,
     learn_time_s: object = 5.0,
     success_radius_m: object = 0.3,
-    tracker: TrackerSpec = "grid",
+    tracker: TrackerSpec = None,
     max_homing_s: object = 60.0,
     progress: object = True,
     mode: object = DEFAULT_HOMING_MODE,
