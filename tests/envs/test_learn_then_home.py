@@ -212,6 +212,10 @@ def test_agent_that_learns_nothing_fails():
         {"max_spots": 0},
         {"scene": "moon"},
         {"compass": "fast"},
+        {"around_m": -0.5},
+        {"around_m": "wide"},
+        {"around_m": 0.8},  # beyond half of the 1 m spot distance
+        {"around_m": 0.5, "learning": "agent"},
     ],
 )
 def test_bad_arguments(kwargs):

@@ -232,6 +232,8 @@ class LearnThenHomeEnv(gym.Env):
 
         if learning_seed is not None:
             int_at_least("learning_seed", learning_seed, 0)
+        if around_m and learning != "scripted":
+            raise ValueError("around_m needs learning='scripted' (the agent learns its own)")
         if atlas_file is not None and learning != "scripted":
             raise ValueError("atlas_file needs learning='scripted' (the agent learns its own)")
         if atlas_file is not None and room_kwargs.get("randomize"):
@@ -259,7 +261,7 @@ class LearnThenHomeEnv(gym.Env):
             learn_time_s=float(learn_time_s),
             compass=compass if compass is not None else CompassConfig(),
             normalise_at=normalise_at,
-            around_m=float(around_m),
+            around_m=nonnegative_float("around_m", around_m),
         )
         self.stop_time_s = float(stop_time_s)
         self.success_radius_m = float(success_radius_m)
