@@ -17,18 +17,18 @@ SHORT = {"learn_time_s": 0.2, "max_homing_s": 8.0}
 
 
 @pytest.mark.slow
-def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path):
-    demo = run_demo(tmp_path, seed=2, progress=False, mode="check-home", **SHORT)
+@pytest.mark.parametrize(("mode", "tracker"), [("check-home", "grid"), ("pose-home", "pose-grid")])
+def test_demo_summary_equals_the_evaluations_record_of_that_episode(tmp_path, mode, tracker):
+    demo = run_demo(tmp_path, seed=2, progress=False, mode=mode, **SHORT)
     # the experiment learns the place in a job, saves the atlas and homes with the
     # loaded atlas: the same episode, so the atlas file is an exact round trip
     opts = ExperimentOptions(seed=2, backend=LocalBackend(1), progress=False)
-    evaluation = run_homing(
-        tmp_path / "homing", opts, episodes=1, field=False, mode="check-home", **SHORT
-    )
+    evaluation = run_homing(tmp_path / "homing", opts, episodes=1, field=False, mode=mode, **SHORT)
     episode = evaluation["per_episode"][0]
     assert episode["seed"] == 3 and demo["learning_seed"] == 2
     assert {k: demo[k] for k in episode} == episode
-    assert demo["mode"] == evaluation["settings"]["mode"] == "check-home"
+    assert demo["mode"] == evaluation["settings"]["mode"] == mode
+    assert demo["tracker"] == evaluation["settings"]["tracker"] == tracker  # the mode's
     assert (tmp_path / "demo.png").read_bytes()[:4] == b"\x89PNG"
 
 
