@@ -183,6 +183,9 @@ def _plot(path: Path, record: EpisodeRecord, learned: LearningResult, top: TopVi
     if learn.size:
         ax.plot(learn[:, 0], learn[:, 1], color="0.8", lw=1, label="learning walk (true)")
     for name, (x, y) in learned.spots.items():
+        if "." in name:  # a turn learned around a spot (around_m): marked, not named
+            ax.plot(x, y, "x", color="yellow", ms=5, mew=1.5)
+            continue
         ax.plot(x, y, "x", color="yellow", ms=10, mew=3)
         ax.annotate(name, (x, y), color="yellow", xytext=(5, 5), textcoords="offset points")
     ax.plot(*record.home, "+", color="white", ms=14, mew=2, label="home")
