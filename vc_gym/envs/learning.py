@@ -5,7 +5,8 @@ The robot stands at home (the field's kickoff circle), turns a full circle there
 panorama at four spots 1 m around home (a full turn in 8 steps of 45°, each direction
 for ``learn_time_s`` with head scanning), walks back home and normalises the spots'
 goodness there. It uses camera frames, head angles and odometry only; the true pose is
-recorded for plots, never used.
+recorded for plots, never used. Beyond the paper, ``LearningConfig(around_m=...)`` also
+learns short turns around home and every spot, for the ``pose`` tracker.
 
 The task env calls a *learner*: any callable ``learner(room, config) -> LearningResult``
 (default :class:`ScriptedLearning`), so tests and users can bring their own.
@@ -151,7 +152,7 @@ class LearningResult:
     atlas : CompassAtlas
         The learned, normalised atlas (home at :data:`HOME`).
     spots : dict
-        Where the robot meant to learn each spot (world metres).
+        Where the robot meant to learn each atlas entry (world metres), by name.
     true_path : list of tuple
         True ``(x, y, yaw)`` of every spot-learning frame (for plots only).
     odometry_turn_scale : float
@@ -369,7 +370,7 @@ class ScriptedLearner:
         per_spot = 8 * (steps + (4 * around_steps if cfg.around_m else 0))
         bar = tqdm(
             total=4 * per_spot + (8 * 4 * around_steps if cfg.around_m else 0),
-            desc="learn 4 spots",
+            desc="learn 4 spots" + (" and the turns around" if cfg.around_m else ""),
             unit="frame",
             disable=not self.progress,
         )
