@@ -284,6 +284,9 @@ def test_ctrl_c_stops_a_running_experiment_and_its_workers(tmp_path):
             stdout=subprocess.DEVNULL,
             stderr=err,
             start_new_session=True,
+            # a terminal's Ctrl-C, even if this test runs with SIGINT ignored (started
+            # as a background job), which the command would otherwise inherit
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
         )
     try:
         deadline = time.monotonic() + 120

@@ -144,7 +144,16 @@ def test_ctrl_c_stops_the_workers_at_once(tmp_path):
     log = tmp_path / "done.txt"
     jobs = square_jobs(2, str(log), sleep_s=60.0)
     pids: list[int] = []
+    # Ctrl-C raises KeyboardInterrupt here even if the tests run with SIGINT ignored
+    # (started as a background job)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _interrupt_two_busy_workers(jobs, pids, log)
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
+
+def _interrupt_two_busy_workers(jobs, pids, log):
     with LocalBackend(2) as backend:
 
         def interrupt() -> None:  # Ctrl-C while both workers are busy

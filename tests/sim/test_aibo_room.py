@@ -26,6 +26,9 @@ SMALL = HeadCameraSpec(52, 40, 56.9)
 ALLOWED_WARNINGS = (
     # SB3 prefers channel-first images; Gymnasium's convention (and ours) is HxWxC
     "channel",
+    # the learning phase says so when a walk did not arrive: in plain_house this small
+    # camera's heading belief does not always settle
+    "walk(s) of the learning phase ended",
 )
 
 

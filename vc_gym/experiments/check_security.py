@@ -364,6 +364,13 @@ def _refused_at_once(
     return run
 
 
+def _hear_ctrl_c() -> None:
+    """In the child before it runs: SIGINT back to its default, so that the child hears
+    the check's Ctrl-C even when this process was started with SIGINT ignored (a
+    shell's background job), which a child would otherwise inherit."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _interrupted(tmp: Path) -> None:
     proc = subprocess.Popen(
         [sys.executable, "-m", "vc_gym.cli", "soak", "--steps", "100000", "--cycles", "10"],
@@ -371,6 +378,7 @@ def _interrupted(tmp: Path) -> None:
         stderr=subprocess.PIPE,
         stdin=subprocess.DEVNULL,
         text=True,
+        preexec_fn=_hear_ctrl_c,
     )
     time.sleep(8.0)
     proc.send_signal(signal.SIGINT)
