@@ -4,10 +4,12 @@ Every agent runs the homing experiment (:func:`~vc_gym.experiments.studies.homin
 with the same learning seeds, the same saved atlases (learned once, by the first agent's
 run) and the same kidnapping seeds, so episode ``i`` of learning seed ``s`` starts from
 the same pose for every agent. The results hold each agent's figures (success within
-30 cm, mean stop distance, stops more than 50 cm from home), the learned agents' mean ±
-standard deviation over agents (e.g. one per training seed, ``vc-gym train --seeds``),
-and a paired comparison with the scripted agent: in how many kidnappings a learned agent
-stopped at least as close to home. ``agents.png`` shows every agent's stop distances.
+30 cm, mean and median stop distance, stops more than 50 cm from home, timeouts, mean
+homing time), the learned agents' mean ± standard deviation over agents (e.g. one per
+training seed, ``vc-gym train --seeds``), and a paired comparison with the scripted
+agent over the same kidnappings: in how many a learned agent stopped at least as close
+to home and was at least as fast, the mean differences, and the ratio of the mean homing
+times. ``agents.png`` shows every agent's stop distances.
 """
 
 from __future__ import annotations
@@ -157,10 +159,14 @@ def _summarise(
                 "std_stop_offset_cm",
                 "far_stops",
                 "timed_out",
+                "mean_homing_time_s",
             )
         }
         rows[label]["per_seed"] = [
-            {k: p[k] for k in ("seed", "success_rate", "mean_stop_distance_cm")}
+            {
+                k: p.get(k)
+                for k in ("seed", "success_rate", "mean_stop_distance_cm", "mean_homing_time_s")
+            }
             for p in res.get("per_seed", [])
         ]
     base = {_key(e): e for e in per_agent[scripted].get("per_episode", [])}
@@ -171,10 +177,15 @@ def _summarise(
             continue
         d_l = np.array([e["home_error_m"] for e in eps])
         d_s = np.array([base[_key(e)]["home_error_m"] for e in eps])
+        t_l = np.array([e["sim_time_s"] for e in eps])
+        t_s = np.array([base[_key(e)]["sim_time_s"] for e in eps])
         paired[label] = {
             "episodes": len(eps),
             "at_least_as_close": int(np.sum(d_l <= d_s + 1e-9)),
             "mean_distance_difference_cm": round(float(np.mean(d_l - d_s)) * 100, 1),
+            "at_least_as_fast": int(np.sum(t_l <= t_s + 1e-9)),
+            "mean_homing_time_difference_s": round(float(np.mean(t_l - t_s)), 1),
+            "homing_time_ratio": round(float(np.mean(t_l) / np.mean(t_s)), 3),
         }
     out: dict[str, Any] = {
         "paper": {
@@ -192,6 +203,8 @@ def _summarise(
             "success_rate": mean_std([r["success_rate"] for r in figures]),
             "mean_stop_distance_cm": mean_std([r["mean_stop_distance_cm"] for r in figures]),
             "far_stops": mean_std([r["far_stops"] for r in figures]),
+            "timed_out": mean_std([r["timed_out"] for r in figures]),
+            "mean_homing_time_s": mean_std([r["mean_homing_time_s"] for r in figures]),
         }
     return out
 
@@ -246,20 +259,26 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
             continue
         lines.append(
             f"{label}: {r['episodes']} kidnappings, success {r['success_rate']:.0%}, mean "
-            f"distance {r['mean_stop_distance_cm']} cm, mean offset {r['mean_stop_offset_cm']} "
-            f"cm, std {r['std_stop_offset_cm']} cm, {r['far_stops']} stops > 50 cm"
+            f"distance {r['mean_stop_distance_cm']} cm (median {r['median_stop_distance_cm']} "
+            f"cm), mean offset {r['mean_stop_offset_cm']} cm, std {r['std_stop_offset_cm']} cm, "
+            f"{r['far_stops']} stops > 50 cm, {r['timed_out']} timed out, mean homing time "
+            f"{r['mean_homing_time_s']} s"
         )
     for label, p in results.get("paired_with_scripted", {}).items():
         lines.append(
             f"{label} vs scripted: at least as close in {p['at_least_as_close']}/"
-            f"{p['episodes']} kidnappings, mean distance {p['mean_distance_difference_cm']:+} cm"
+            f"{p['episodes']} kidnappings, mean distance {p['mean_distance_difference_cm']:+} cm; "
+            f"at least as fast in {p['at_least_as_fast']}/{p['episodes']}, mean homing time "
+            f"{p['mean_homing_time_difference_s']:+} s ({p['homing_time_ratio']:.2f} × "
+            "the scripted agent's)"
         )
     lo = results.get("learned_over_agents")
     if lo:
-        s, d = lo["success_rate"], lo["mean_stop_distance_cm"]
+        s, d, t = lo["success_rate"], lo["mean_stop_distance_cm"], lo["mean_homing_time_s"]
         lines.append(
             f"learned agents ({lo['agents']}): success {s[0]:.0%} ± {s[1]:.0%}, mean distance "
-            f"{d[0]:.1f} ± {d[1]:.1f} cm (mean ± std over agents)"
+            f"{d[0]:.1f} ± {d[1]:.1f} cm, mean homing time {t[0]:.1f} ± {t[1]:.1f} s "
+            "(mean ± std over agents)"
         )
     lines.append("paper: mean stop offset (-22, 12) cm, std (17, 15) cm over 33 kidnappings")
     return lines
