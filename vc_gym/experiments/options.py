@@ -58,8 +58,9 @@ HOMING_MODE_HELP = (
     "the true home, and home checked with a full turn before stopping; paper: the "
     "paper's procedure (normalised after walking back home by odometry, stop where "
     "the estimate says home); pose-home: check-home's learning plus turns 0.5 m around "
-    "home and every spot, homing on the pose tracker, stopping without the checking turn "
-    "when its position is sure; improved: deprecated name of check-home"
+    "home and every spot, homing on the pose-grid tracker (the pose belief away from home, "
+    "the paper's filters near it) and checking home with a full turn; improved: "
+    "deprecated name of check-home"
 )
 
 
