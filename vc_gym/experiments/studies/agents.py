@@ -63,7 +63,7 @@ def run_agents(
     out_dir: str | os.PathLike,
     opts: ExperimentOptions | None = None,
     agent: str | Sequence[str] = "scripted,pretrained",
-    tracker: Any = "grid",
+    tracker: Any = None,
     seeds: Sequence[int] | None = None,
     episodes: int | None = None,
     learn_time_s: float | None = None,
