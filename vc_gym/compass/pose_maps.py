@@ -153,8 +153,9 @@ class PoseMaps:
         if not isinstance(atlas, CompassAtlas):
             raise ValueError(f"atlas must be a CompassAtlas, got {type(atlas).__name__}")
         index = {n: k for k, n in enumerate(atlas.names)}
+        groups = around_groups(atlas.names)
         spots = []
-        for name, members in around_groups(atlas.names).items():
+        for name, members in groups.items():
             k = index[name]
             spot, spot_map = atlas.positions[k], atlas.compasses[k]
             around = [
@@ -166,7 +167,7 @@ class PoseMaps:
                 far = np.full(spot_map.config.n_sectors, 1e3)  # nothing moves: the plain map
                 spots.append(ParallaxMap(spot, far, [(spot, spot_map)]))
         out = cls(spots, lattice_m, reach_m)
-        out.names = tuple(around_groups(atlas.names))
+        out.names = tuple(groups)
         return out
 
     def __len__(self) -> int:

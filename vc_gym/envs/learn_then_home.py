@@ -25,6 +25,7 @@ from vc_gym.envs.learning import (
     ScriptedLearning,
     kidnap_pose,
     paper_spots,
+    scripted_atlas_size,
 )
 from vc_gym.envs.place_cache import CachedLearner, PlaceCache, place_key_value
 from vc_gym.poses import compose
@@ -299,9 +300,9 @@ class LearnThenHomeEnv(gym.Env):
         self.cached_learner: CachedLearner | None = None
         self._room_kwargs = dict(room_kwargs)
         self._seeded = learning_seed is not None
-        # the scripted learning's atlas: four spots, or with turns around them and home 25
-        scripted_spots = 25 if self.learn_config.around_m else 4
-        self.max_spots = scripted_spots if learning == "scripted" else int(max_spots)
+        self.max_spots = (
+            scripted_atlas_size(self.learn_config) if learning == "scripted" else int(max_spots)
+        )
         self.spot_radius_m = float(spot_radius_m)
         self.control_dt = self.room.control_dt
         self.camera = self.room.camera

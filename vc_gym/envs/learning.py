@@ -48,6 +48,7 @@ __all__ = [
     "ScriptedLearner",
     "ScriptedLearning",
     "paper_spots",
+    "scripted_atlas_size",
     "SpotLearning",
     "GridLearning",
     "kidnap_pose",
@@ -60,6 +61,19 @@ SPOT_NAMES = ("east", "north", "west", "south")
 NORMALISE_AT = ("return", "start")
 #: Head pans cycled while the robot learns a direction, and while it stands still homing.
 HEAD_SCAN_DEG = (-40.0, -20.0, 0.0, 20.0, 40.0, 20.0, 0.0, -20.0)
+
+
+#: The turns learned around home and each spot with ``around_m``, in the order walked:
+#: east, north, west, south (entries ``NAME.e``, ``NAME.n``, ...).
+AROUND_SIDES = ("e", "n", "w", "s")
+
+
+def scripted_atlas_size(config: LearningConfig) -> int:
+    """Entries of the atlas :meth:`ScriptedLearner.learn` makes with ``config``: the four
+    spots, or with ``around_m`` home and the spots each with its turns around."""
+    if not config.around_m:
+        return len(SPOT_NAMES)
+    return (1 + len(SPOT_NAMES)) * (1 + len(AROUND_SIDES))
 
 
 class RobotFell(Exception):
@@ -367,9 +381,11 @@ class ScriptedLearner:
         self.learn_turn(steps)
         colors = self.home_compass.colors
         compasses: dict[str, tuple[tuple[float, float], VisualCompass]] = {}
-        per_spot = 8 * (steps + (4 * around_steps if cfg.around_m else 0))
+        # frames: the four spots' turns, and with around_m four short turns around home
+        # and around each spot
+        around_frames = len(AROUND_SIDES) * 8 * around_steps if cfg.around_m else 0
         bar = tqdm(
-            total=4 * per_spot + (8 * 4 * around_steps if cfg.around_m else 0),
+            total=len(SPOT_NAMES) * 8 * steps + (1 + len(SPOT_NAMES)) * around_frames,
             desc="learn 4 spots" + (" and the turns around" if cfg.around_m else ""),
             unit="frame",
             disable=not self.progress,
@@ -434,7 +450,7 @@ class ScriptedLearner:
         x, y = spot
         out = {}
         for side, (px, py) in zip(
-            "enws", ((x + r, y), (x, y + r), (x - r, y), (x, y - r)), strict=True
+            AROUND_SIDES, ((x + r, y), (x, y + r), (x - r, y), (x, y - r)), strict=True
         ):
             self._walk_to(px, py)
             out[f"{name}.{side}"] = ((px, py), self._learn_here(colors, steps, path, bar))

@@ -84,6 +84,7 @@ from vc_gym.experiments.studies.tracking.routes import (
     make_route,
 )
 from vc_gym.jobs.job import Job
+from vc_gym.sim.scenes import scene_names
 from vc_gym.validation import (
     MAX_EPISODES,
     MAX_LEARN_TIME_S,
@@ -194,8 +195,6 @@ def run_tracking(
     dict
         The results written to ``results.json``.
     """
-    from vc_gym.sim.scenes import scene_names
-
     opts = opts or ExperimentOptions()
     size = pick_size(SIZES, opts.size)
     named = check_trackers(trackers or size["trackers"] or DEFAULT_TRACKERS)
