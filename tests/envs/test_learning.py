@@ -244,6 +244,15 @@ def test_a_walk_that_cannot_arrive_ends_at_the_time_limit():
     room.close()
 
 
+def test_the_scripted_atlas_size_counts_the_turns_around():
+    from vc_gym.envs.learning import scripted_atlas_size
+
+    assert scripted_atlas_size(LearningConfig()) == 4
+    assert scripted_atlas_size(LearningConfig(around_m=0.5)) == 25  # 5 places × (1 + 4)
+    with pytest.raises(ValueError, match="LearningConfig"):
+        scripted_atlas_size({"around_m": 0.5})
+
+
 def test_a_config_keys_its_place_by_turns_around_only_when_set():
     assert "around_m" not in LearningConfig().to_key()  # the paper's places keep their keys
     key = LearningConfig(around_m=0.5).to_key()

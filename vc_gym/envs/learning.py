@@ -71,6 +71,7 @@ AROUND_SIDES = ("e", "n", "w", "s")
 def scripted_atlas_size(config: LearningConfig) -> int:
     """Entries of the atlas :meth:`ScriptedLearner.learn` makes with ``config``: the four
     spots, or with ``around_m`` home and the spots each with its turns around."""
+    _check_config(config)
     if not config.around_m:
         return len(SPOT_NAMES)
     return (1 + len(SPOT_NAMES)) * (1 + len(AROUND_SIDES))
