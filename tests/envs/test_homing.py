@@ -260,6 +260,45 @@ def test_previous_action_appends_the_last_action_taken():
 
 
 @pytest.mark.slow
+def test_position_std_adds_the_trackers_position_spread_in_the_pose_home_mode():
+    from gymnasium.utils.env_checker import check_env
+
+    from vc_gym.agents.learned import homing_spaces
+    from vc_gym.envs.homing_modes import homing_mode
+
+    mode = homing_mode("pose-home")
+    kwargs = {
+        **FAST,
+        **mode.learning,
+        "tracker": mode.tracker,
+        "position_std": True,
+        "previous_action": True,
+    }
+    env = gym.make("vc_gym/Homing-v0", **kwargs)
+    obs, _ = env.reset(seed=0)
+    u = env.unwrapped
+    assert u.n_spots == 25  # four spots and home, each with four turns around it
+    assert env.observation_space.shape == (8 + 25 + 2 + 3,)
+    assert homing_spaces(kwargs)[0] == env.observation_space  # what a saved agent is checked by
+    where = HomingFeatures.position_std_slice(u.n_spots)
+    spread = np.asarray(u.last_state.position_std_m) / HomingFeatures.POSITION_STD_SCALE_M
+    np.testing.assert_allclose(obs[where], spread, rtol=1e-6)
+    assert np.all(spread > 0)  # a belief just after a kidnapping is not sure of anything
+    for _ in range(3):
+        obs, *_ = env.step(np.array([0.5, 0.0, -1.0]))
+        spread = np.asarray(u.last_state.position_std_m) / HomingFeatures.POSITION_STD_SCALE_M
+        np.testing.assert_allclose(obs[where], spread, rtol=1e-6)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        check_env(env)  # the place is learned: its resets only kidnap
+    problems = [str(w.message) for w in record if "unwrapped version" not in str(w.message)]
+    assert not problems, problems
+    env.close()
+    with pytest.raises(ValueError, match="position_std"):
+        gym.make("vc_gym/Homing-v0", position_std="yes", **FAST)
+
+
+@pytest.mark.slow
 def test_the_env_class_steps_as_the_task_wrapped_by_hand():
     # HomingEnv applies the wrappers inside itself; its episodes are those of the task
     # wrapped by hand (what vc_gym/Homing-v0 was built as, what trained policies saw)

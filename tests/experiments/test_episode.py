@@ -91,3 +91,18 @@ def test_a_learned_agent_runs_with_its_stops_checked():
     assert isinstance(wrapper, StopAction)
     assert wrapper.confirm_stop_m == LEARNED_CONFIRM_STOP_M == 0.25
     run.env.close()
+
+
+def test_a_learned_agent_homes_in_the_mode_of_its_training_places():
+    from types import SimpleNamespace
+
+    from vc_gym.agents.learned import PRETRAINED_MODEL
+    from vc_gym.experiments.episode import default_homing_mode, homing_mode
+
+    assert default_homing_mode("scripted") == "check-home"
+    assert default_homing_mode(str(PRETRAINED_MODEL)) == "paper"  # trained on paper places
+    pose = SimpleNamespace(env_kwargs={**homing_mode("pose-home").learning}, path="m.zip")
+    assert default_homing_mode(pose) == "pose-home"
+    odd = SimpleNamespace(env_kwargs={"around_m": 0.3}, path="odd/model.zip")
+    with pytest.raises(ValueError, match="odd/model.zip.*none of the homing modes"):
+        default_homing_mode(odd)

@@ -112,10 +112,17 @@ def test_places_are_checked_and_saved():
 
 
 def test_goal_correction_settings():
-    # the default goal is measured and centred (README, Learned agents: learning seeds 30-32)
-    assert TrainConfig().home_offset_episodes == 10 and TrainConfig().home_offset_places == 3
-    assert TrainConfig().home_offset_centre is True and TrainConfig().home_offset_m is None
-    assert "home_offset_m" not in TrainConfig(seed=0).env_kwargs()  # until it is measured
+    # in the paper's mode the default goal is measured and centred (README, Learned agents:
+    # learning seeds 30-32); the other modes normalise at the true home and measure none
+    paper = TrainConfig(mode="paper")
+    assert paper.home_offset_episodes == 10 and paper.home_offset_places == 3
+    assert paper.home_offset_centre is True and paper.home_offset_m is None
+    for mode in ("pose-home", "check-home"):
+        assert TrainConfig(mode=mode).home_offset_episodes == 0
+        assert TrainConfig(mode=mode).home_offset_centre is False
+    assert TrainConfig().home_offset_episodes == 0  # the default mode is pose-home
+    assert TrainConfig(mode="paper", home_offset_m=(0.1, 0.0)).home_offset_episodes == 0
+    assert "home_offset_m" not in paper.env_kwargs()  # until it is measured
     assert TrainConfig(seed=2).home_offset_seeds == (2, 2_000_032, 2_000_033, 2_000_034)
     given = replace(TINY, home_offset_m=(0.05, -0.1))
     assert given.env_kwargs()["home_offset_m"] == [0.05, -0.1]
@@ -140,7 +147,34 @@ def test_goal_correction_settings():
         {"home_offset_m": "0.1,0.2"},
         {"home_offset_centre": "yes"},
         {"home_offset_centre": 1},
-        {"home_offset_episodes": 0},  # nothing measured to centre (centring is the default)
+        {"home_offset_episodes": 0, "home_offset_centre": True},  # nothing measured to centre
     ):
         with pytest.raises(ValueError, match="home_offset"):
             TrainConfig(**bad)
+
+
+def test_mode_and_position_spread():
+    # the default recipe: pose-home's places and tracker, the position's spread in view
+    config = TrainConfig()
+    assert config.mode == "pose-home" and config.tracker == "pose-grid"
+    env = config.env_kwargs()
+    assert env["normalise_at"] == "start" and env["around_m"] == 0.5
+    assert env["position_std"] is True and env["tracker"] == "pose-grid"
+    paper = TrainConfig(mode="paper", position_std=False)
+    assert paper.tracker == "grid"
+    assert not {"normalise_at", "around_m", "position_std"} & set(paper.env_kwargs())
+    assert TrainConfig(mode="check-home").env_kwargs()["normalise_at"] == "start"
+    assert TrainConfig(mode="pose-home", tracker="grid").tracker == "grid"  # given wins
+    with pytest.warns(DeprecationWarning):
+        assert TrainConfig(mode="improved").mode == "check-home"
+    for bad in ("best", None, 3):
+        with pytest.raises(ValueError, match="mode"):
+            TrainConfig(mode=bad)
+    for bad in ("yes", 1, None):
+        with pytest.raises(ValueError, match="position_std"):
+            TrainConfig(position_std=bad)
+    # round trip, and a config.json saved before the fields: the paper's places, no spread
+    assert TrainConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
+    before = {k: v for k, v in paper.to_dict().items() if k not in ("mode", "position_std")}
+    old = TrainConfig.from_dict(before)
+    assert old.mode == "paper" and old.position_std is False and old.tracker == "grid"

@@ -91,3 +91,43 @@ def test_with_its_last_action_the_rest_is_unchanged():
         )
     with pytest.raises(ValueError, match="previous_action"):
         HomingFeatureExpert(previous_action="yes")
+
+
+def test_walks_at_its_fastest_speed_far_from_home():
+    walk, _, _ = HomingFeatureExpert(max_speed_m_s=0.4).predict(features(2.0, 0.0))
+    assert walk == pytest.approx(1.0)  # max_forward 0.4 m/s
+    walk, _, _ = HomingFeatureExpert(max_speed_m_s=0.4).predict(features(0.3, 0.0))
+    assert walk == pytest.approx(0.8 * 0.3 / 0.4, abs=1e-5)  # slower when close, as before
+
+
+def with_spread(f: np.ndarray, spread_m: float, spots: int = 4) -> np.ndarray:
+    spread = np.full(2, spread_m / HomingFeatures.POSITION_STD_SCALE_M, np.float32)
+    out = np.concatenate([f, spread])
+    assert out[HomingFeatures.position_std_slice(spots)].tolist() == spread.tolist()
+    return out
+
+
+def test_does_not_stop_at_home_while_the_position_is_unsure():
+    expert = HomingFeatureExpert(max_position_std_m=0.2)
+    at_home = features(0.05, 0.0)
+    walk, turn, stop = expert.predict(with_spread(at_home, 0.5))
+    assert stop < STOP_THRESHOLD and walk <= 0.0 and turn != 0.0  # turns in place, scanning
+    assert expert.predict(with_spread(at_home, 0.1))[2] > STOP_THRESHOLD
+    # away from home the spread changes nothing
+    far = features(1.0, 0.0)
+    np.testing.assert_array_equal(
+        expert.predict(with_spread(far, 0.5)), HomingFeatureExpert().predict(far)
+    )
+    # the rule without the setting stops on the estimate alone
+    assert HomingFeatureExpert().predict(with_spread(at_home, 0.5))[2] > STOP_THRESHOLD
+    with pytest.raises(ValueError, match="position's spread"):
+        expert.predict(features(0.05, 0.0, spots=1)[:-1])
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [{"max_speed_m_s": 0.5}, {"max_speed_m_s": 0.0}, {"max_position_std_m": -0.1}],
+)
+def test_bad_speed_and_spread_settings_are_rejected(kwargs):
+    with pytest.raises(ValueError, match="max_speed_m_s|max_position_std_m"):
+        HomingFeatureExpert(**kwargs)

@@ -26,6 +26,7 @@ from gymnasium import spaces
 from vc_gym.config_files import read_settings
 from vc_gym.envs.homing import HomingEnv, HomingFeatures, PreviousAction
 from vc_gym.envs.learn_then_home import LearnThenHomeEnv
+from vc_gym.envs.learning import LearningConfig, scripted_atlas_size
 from vc_gym.localization.registry import TRACKERS
 from vc_gym.plugins import check_file_spec, check_plain_data
 from vc_gym.sim.aibo_room import AiboRoomEnv
@@ -73,6 +74,9 @@ CONFIG_ENV_KEYS = (
     "previous_action",
     "min_walk_s",
     "head_scan",
+    "position_std",
+    "normalise_at",
+    "around_m",
 )
 
 #: ``vc_gym/Homing-v0`` arguments that choose the place a run trained in. An evaluation
@@ -205,9 +209,16 @@ def parse_env_kwargs(pairs: Sequence[str], where: str = "--env-kwargs") -> dict[
 
 def homing_spaces(env_kwargs: Mapping[str, Any]) -> tuple[spaces.Box, spaces.Box]:
     """The observation and action spaces of ``vc_gym/Homing-v0`` with ``env_kwargs``,
-    without building it: the features of the scripted learning's four spots
-    (:class:`~vc_gym.envs.HomingFeatures`), the last action with ``previous_action``."""
-    n = HomingFeatures.GOODNESS_START + 1 + 4
+    without building it: the features (:class:`~vc_gym.envs.HomingFeatures`) of the
+    scripted learning's atlas (four spots, or 25 entries with ``around_m``), the
+    position's spread with ``position_std``, the last action with ``previous_action``."""
+    around_m = env_kwargs.get("around_m", 0.0)
+    if isinstance(around_m, bool) or not isinstance(around_m, (int, float)):
+        raise ValueError(f"around_m must be a number of metres, got {around_m!r}")
+    n_spots = scripted_atlas_size(LearningConfig(around_m=float(around_m)))
+    n = HomingFeatures.GOODNESS_START + 1 + n_spots
+    if env_kwargs.get("position_std", False):
+        n += 2
     if env_kwargs.get("previous_action", False):
         n += PreviousAction.WIDTH
     return (

@@ -82,8 +82,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--mode",
         choices=HOMING_MODE_CHOICES,
         help="how the place is learned and the scripted agent homes (default: check-home; "
-        "paper for a learned agent, whose training places were learned the paper's way): "
-        + HOMING_MODE_HELP,
+        "for a learned agent the mode its training places were learned in, from its "
+        "config.json: paper for the shipped one): " + HOMING_MODE_HELP,
     )
     add_tracker_option(p)
     p.add_argument(

@@ -11,6 +11,7 @@ from vc_gym.cli.arguments import (
     add_allow_imports_option,
     argument_type,
 )
+from vc_gym.envs.homing_modes import HOMING_MODES
 from vc_gym.experiments.options import parse_int_list, parse_tracker_spec
 
 __all__ = ["add_parser", "resume_hint", "run"]
@@ -36,6 +37,8 @@ _TRAIN_FIELDS = {
     "home_offset_episodes": "home_offset_episodes",
     "home_offset_places": "home_offset_places",
     "home_offset_centre": "home_offset_centre",
+    "mode": "mode",
+    "position_std": "position_std",
 }
 
 
@@ -86,12 +89,28 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "place of --seed)",
     )
     p.add_argument(
+        "--mode",
+        choices=list(HOMING_MODES),
+        help="how the training places are learned and which tracker the agent homes on: "
+        "pose-home (default: turns learned 0.5 m around home and every spot, normalised at "
+        "the true home, the pose-grid tracker), check-home (normalised at the true home, "
+        "grid) or paper (the paper's procedure, grid); every evaluation of the agent "
+        "learns its places the same way",
+    )
+    p.add_argument(
         "--tracker",
         type=argument_type(parse_tracker_spec, "tracker"),
         metavar="SPEC",
-        help="tracker of the agent's env: grid (the paper's filters, default), particle, "
-        "kalman, 'package.module:factory', or a JSON object such as "
-        '\'{"type": "particle", "n_particles": 500}\'',
+        help="tracker of the agent's env (default: the mode's): grid (the paper's "
+        "filters), pose-grid, particle, kalman, 'package.module:factory', or a JSON object "
+        'such as \'{"type": "particle", "n_particles": 500}\'',
+    )
+    p.add_argument(
+        "--position-std",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the policy also sees the tracker's position spread, so that it can learn "
+        "when to trust the position (default on)",
     )
     add_allow_imports_option(p, "--config FILE and a --resume run's config.json")
     p.add_argument(
@@ -152,8 +171,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="before the warm start the scripted expert homes N times in each training "
         "place and --home-offset-places more; the median of (tracker's position - true "
         "position) at its stops becomes the policy's goal, so that it stops at the true "
-        "home, not where the tracker puts home (DIR/home_offset.json; default 10; 0: the "
-        "tracker's home, with --no-home-offset-centre)",
+        "home, not where the tracker puts home (DIR/home_offset.json; default 10 with "
+        "--mode paper, whose spots are normalised where the walk back ends, else 0; 0: "
+        "the tracker's home, with --no-home-offset-centre)",
     )
     p.add_argument(
         "--home-offset-places",
@@ -168,8 +188,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default=None,
         help="then let the expert home again on the same kidnappings going to the measured "
         "goal, and move the goal so that its median stop lies at the true home (a secant "
-        "step per axis; the stops can move further than the goal did; default on; needs "
-        "--home-offset-episodes of 1 or more)",
+        "step per axis; the stops can move further than the goal did; default on when the "
+        "offset is measured; needs --home-offset-episodes of 1 or more)",
     )
     p.add_argument("--tensorboard-log", metavar="DIR", help="also write TensorBoard logs to DIR")
     p.add_argument(

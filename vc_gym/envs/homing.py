@@ -84,9 +84,13 @@ class HomingFeatures(gym.ObservationWrapper):
     """The compass outputs of :class:`~vc_gym.envs.CompassObservation` as one vector.
 
     ``[home_vector / 2 m (2), cos θ̂, sin θ̂, heading spread / 180°, position / 2 m (2),
-    log goodness / 5 (one per spot, clipped to ±5), head pan / 90°]``: all of order 1.
-    The class attributes name the slices and scales (what an agent reading the vector
-    uses instead of bare indices).
+    log goodness / 5 (one per spot, clipped to ±5), head pan / 90°]``, and with
+    ``position_std=True`` the position's spread per axis / 0.5 m (2) after them: all of
+    order 1. The class attributes name the slices and scales (what an agent reading the
+    vector uses instead of bare indices; :meth:`position_std_slice` where the spread is).
+    The spread lets a policy tell a position it can trust (a tracker with a position
+    belief, such as ``pose-grid``, reports a few centimetres at home and metres after a
+    kidnapping) from one it cannot.
 
     ``home_offset_m`` moves the goal the vector describes from the atlas' home to that
     point (world frame, metres from it): the home vector points there and the position
@@ -103,17 +107,30 @@ class HomingFeatures(gym.ObservationWrapper):
     GOODNESS_START = 7
     METRES_SCALE = 2.0
     SPREAD_SCALE_DEG = 180.0
+    POSITION_STD_SCALE_M = 0.5
 
-    def __init__(self, env: gym.Env, home_offset_m: Any = (0.0, 0.0)):
+    def __init__(
+        self, env: gym.Env, home_offset_m: Any = (0.0, 0.0), position_std: bool = False
+    ):
         super().__init__(env)
         self.home_offset_m = home_offset(home_offset_m)
+        self.position_std = flag("position_std", position_std)
         space = env.observation_space
         needed = {"home_vector", "heading", "heading_spread", "position", "goodness", "head"}
+        if self.position_std:
+            needed.add("position_std")
         if not isinstance(space, spaces.Dict) or not needed <= set(space.spaces):
             raise ValueError(f"HomingFeatures needs a CompassObservation env, got {space}")
         self.n_spots = space["goodness"].shape[0]
-        n = 8 + self.n_spots
+        n = 8 + self.n_spots + (2 if self.position_std else 0)
         self.observation_space = spaces.Box(-10.0, 10.0, (n,), np.float32)
+
+    @classmethod
+    def position_std_slice(cls, n_spots: int) -> slice:
+        """Where the position's spread lies in a vector of ``n_spots`` spots with
+        ``position_std=True``."""
+        start = cls.GOODNESS_START + n_spots + 1
+        return slice(start, start + 2)
 
     def observation(self, obs: dict[str, np.ndarray]) -> np.ndarray:
         g = np.log(np.maximum(obs["goodness"].astype(np.float64), 1e-12)) / 5.0
@@ -130,6 +147,11 @@ class HomingFeatures(gym.ObservationWrapper):
                 position / self.METRES_SCALE,
                 np.clip(g, -5.0, 5.0),
                 obs["head"][:1] / 90.0,
+                *(
+                    [obs["position_std"].astype(np.float64) / self.POSITION_STD_SCALE_M]
+                    if self.position_std
+                    else []
+                ),
             ]
         )
         return np.clip(f, -10.0, 10.0).astype(np.float32)
@@ -388,10 +410,12 @@ class HomingEnv(LearnThenHomeEnv):
 
     ## Observation Space
 
-    ``Box(-10, 10, (8 + n_spots,), float32)`` (``n_spots`` = 4 for the paper's spots):
-    home vector / 2 m, ``(cos θ̂, sin θ̂)``, heading spread / 180°, position / 2 m, log
-    goodness / 5 of each spot, head pan / 90° (:class:`HomingFeatures`); with
-    ``previous_action=True`` the last action taken follows (3 more entries).
+    ``Box(-10, 10, (8 + n_spots,), float32)`` (``n_spots`` = 4 for the paper's spots,
+    25 with turns around them, ``around_m``): home vector / 2 m, ``(cos θ̂, sin θ̂)``,
+    heading spread / 180°, position / 2 m, log goodness / 5 of each spot, head pan / 90°
+    (:class:`HomingFeatures`); with ``position_std=True`` the position's spread / 0.5 m
+    follows (2 more entries), and with ``previous_action=True`` the last action taken (3
+    more).
 
     ## Rewards, Starting State, Episode End, Info
 
@@ -416,6 +440,9 @@ class HomingEnv(LearnThenHomeEnv):
         :class:`HomingFeatures`' goal, relative to the atlas' home (world frame, m).
     previous_action : bool
         Append the last action to the features (:class:`PreviousAction`). Default False.
+    position_std : bool
+        The features carry the tracker's position spread (:class:`HomingFeatures`).
+        Default False.
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``learning_seed``,
@@ -433,10 +460,12 @@ class HomingEnv(LearnThenHomeEnv):
         min_walk_m: float = 0.0,
         home_offset_m: Any = (0.0, 0.0),
         previous_action: bool = False,
+        position_std: bool = False,
         **task_kwargs: Any,
     ):
         home_offset_m = home_offset(home_offset_m)  # refused before a world is built
         self.previous_action = flag("previous_action", previous_action)
+        flag("position_std", position_std)
         if task_kwargs.get("learning", "scripted") != "scripted":
             raise ValueError("vc_gym/Homing-v0 learns the place by script (learning='scripted')")
         super().__init__(**task_kwargs)
@@ -445,7 +474,7 @@ class HomingEnv(LearnThenHomeEnv):
             self.compass_observation = CompassObservation(
                 _Task(self), keep_image=False, tracker=tracker
             )
-            self.features = HomingFeatures(self.compass_observation, home_offset_m)
+            self.features = HomingFeatures(self.compass_observation, home_offset_m, position_std)
             self.stop_action = StopAction(
                 self.features,
                 max_forward,

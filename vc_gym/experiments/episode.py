@@ -24,8 +24,16 @@ from tqdm import tqdm
 from vc_gym.agents.learned import LearnedHomingAgent
 from vc_gym.agents.scripted import ScriptedHomingAgent
 from vc_gym.angles import wrap180
-from vc_gym.deprecation import renamed
 from vc_gym.envs.homing import LEARNED_CONFIRM_STOP_M
+from vc_gym.envs.homing_modes import (
+    DEFAULT_HOMING_MODE,
+    HOMING_MODES,
+    LEARNED_AGENT_MODE,
+    HomingMode,
+    canonical_homing_mode,
+    homing_mode,
+    mode_of_task,
+)
 from vc_gym.envs.learn_then_home import make_task
 from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
@@ -46,6 +54,7 @@ __all__ = [
     "make_agent_env",
     "make_homing_run",
     "homing_mode",
+    "mode_of_task",
     "run_episode",
 ]
 
@@ -163,88 +172,30 @@ class HomingRun:
         self.env.close()
 
 
-@dataclass(frozen=True)
-class HomingMode:
-    """How the place is learned and how the scripted agent homes, by name.
-
-    Attributes
-    ----------
-    learning : dict
-        Task arguments of ``vc_gym/LearnThenHome-v0`` that shape the learned atlas
-        (saved with it: ``normalise_at``).
-    policy : dict
-        Keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`.
-    tracker : str or dict
-        The tracker the mode homes on unless another is given.
-    """
-
-    learning: dict[str, Any]
-    policy: dict[str, Any]
-    tracker: TrackerSpec = "grid"
-
-
-#: The homing modes. ``paper``: the paper's procedure (5.2), normalising the spots
-#: after walking back home by odometry, whose drift (15-20 cm in the simulated robolab)
-#: becomes the stops' systematic offset, and stopping wherever the estimate says home.
-#: ``check-home`` (the default): normalising with every frame of the first turn, taken at
-#: the true home before the robot moved, and checking with a full turn that the place is
-#: home before stopping (``verify_home``; a single view can alias with home 1-2 m away).
-#: ``pose-home``: check-home's normalisation, with turns learned 0.5 m around home and
-#: every spot (``around_m``) so that the ``pose`` tracker can re-draw the maps for a
-#: position; the robot homes on the ``pose-grid`` tracker (the pose belief away from
-#: home, which does not get stuck where a view aliases with home; the paper's filters
-#: within 0.5 m of it, which answer home exactly there) and checks home with a full turn
-#: as check-home does, walking the checked offset itself (``verify_gain`` 1: the pose
-#: belief's offset does not shrink with distance as eq. 30's does). It settles for 1 s
-#: instead of 2 s and turns its checks as fast as the robot turns (86°/s) instead of at
-#: 60°/s, so that a homing that needs several checks ends within the time limit.
-HOMING_MODES: dict[str, HomingMode] = {
-    "paper": HomingMode(learning={}, policy={}),
-    "check-home": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
-    "pose-home": HomingMode(
-        learning={"normalise_at": "start", "around_m": 0.5},
-        policy={
-            "verify_home": True,
-            "verify_gain": 1.0,
-            "verify_turn_deg_s": 90.0,
-            "settle_time_s": 1.0,
-        },
-        tracker="pose-grid",
-    ),
-}
-#: The homing mode of the demo, ``vc-gym evaluate`` and every experiment unless told.
-DEFAULT_HOMING_MODE = "check-home"
-#: The mode a learned agent homes in unless told: the one whose places it trained on
-#: (``vc-gym train`` learns its places the paper's way).
-LEARNED_AGENT_MODE = "paper"
-#: Deprecated names of homing modes, accepted with a ``DeprecationWarning``.
-DEPRECATED_HOMING_MODES = {"improved": "check-home"}
-
-
-def default_homing_mode(agent: str) -> str:
+def default_homing_mode(agent: Any) -> str:
     """The homing mode for ``agent`` when none is given: :data:`DEFAULT_HOMING_MODE` for
-    the scripted agent, :data:`LEARNED_AGENT_MODE` for a learned one (a policy is
-    evaluated in places learned the way its training places were)."""
-    return DEFAULT_HOMING_MODE if agent == "scripted" else LEARNED_AGENT_MODE
-
-
-def canonical_homing_mode(mode: object) -> str:
-    """The name of homing mode ``mode`` (a deprecated name warns and gives the new one).
+    ``"scripted"``; for a learned agent (a loaded one, or the path of its
+    ``model.zip``), the mode its places were learned in (:func:`mode_of_task` of its env
+    arguments: a policy is evaluated in places learned the way its training places were).
 
     Raises
     ------
     ValueError
-        Naming the modes, for anything else.
+        For a learned agent whose places were learned in no homing mode (pass ``mode``).
     """
-    mode = renamed("homing mode", mode, DEPRECATED_HOMING_MODES, stacklevel=3)
-    if not isinstance(mode, str) or mode not in HOMING_MODES:
-        raise ValueError(f"mode must be one of {list(HOMING_MODES)}, got {mode!r}")
+    if isinstance(agent, str):
+        if agent == "scripted":
+            return DEFAULT_HOMING_MODE
+        agent = load_agent(agent)
+    if isinstance(agent, ScriptedHomingAgent):
+        return DEFAULT_HOMING_MODE
+    mode = mode_of_task(agent.env_kwargs)
+    if mode is None:
+        raise ValueError(
+            f"{agent.path}: its env arguments learn places in none of the homing modes "
+            f"{list(HOMING_MODES)}; name the mode to evaluate it in"
+        )
     return mode
-
-
-def homing_mode(mode: str) -> HomingMode:
-    """The :class:`HomingMode` called ``mode``, or a ``ValueError`` naming the modes."""
-    return HOMING_MODES[canonical_homing_mode(mode)]
 
 
 def make_homing_run(
@@ -272,8 +223,9 @@ def make_homing_run(
         on, ``vc_gym/Homing-v0``, with the task's 5 s stop rule, its stops checked while
         it stands: :data:`LEARNED_CONFIRM_STOP_M`).
     tracker : str, dict or callable, optional
-        The tracker (see :func:`vc_gym.localization.make_tracker`); default the
-        mode's (:attr:`HomingMode.tracker`).
+        The tracker (see :func:`vc_gym.localization.make_tracker`); default a learned
+        agent's own (the one it trained with), else the mode's
+        (:attr:`HomingMode.tracker`).
     scene, learn_time_s, success_radius_m, relearn, max_homing_s
         Task arguments (see ``LearnThenHomeEnv``).
     learner : callable, optional
@@ -286,9 +238,9 @@ def make_homing_run(
         env instead, see :class:`~vc_gym.experiments.video.EpisodeVideo`).
     mode : str
         How the place is learned and how the scripted agent homes
-        (:data:`HOMING_MODES`): ``"check-home"`` or ``"paper"``; default
-        :func:`default_homing_mode` (check-home for the scripted agent, paper for a
-        learned one). With a saved atlas
+        (:data:`HOMING_MODES`): ``"check-home"``, ``"paper"`` or ``"pose-home"``;
+        default :func:`default_homing_mode` (check-home for the scripted agent, the
+        mode of its training places for a learned one). With a saved atlas
         (``learner``) only the policy part applies; the atlas brings its own learning.
     policy : dict, optional
         More keyword arguments of :class:`~vc_gym.agents.ScriptedHomingPolicy`,
@@ -297,8 +249,10 @@ def make_homing_run(
         Let a learned agent's ``config.json`` name its tracker by import path (imports
         that module; :class:`~vc_gym.agents.learned.LearnedHomingAgent`).
     """
-    chosen = homing_mode(default_homing_mode(agent) if mode is None else mode)
-    tracker = chosen.tracker if tracker is None else tracker
+    loaded = load_agent(agent, allow_imports)
+    chosen = homing_mode(default_homing_mode(loaded) if mode is None else mode)
+    if tracker is None:  # a learned agent homes on the tracker it trained with
+        tracker = loaded.env_kwargs.get("tracker", chosen.tracker)
     policy_kwargs = {**chosen.policy, **(policy or {})}
     task: dict[str, Any] = {
         "scene": scene,
@@ -311,9 +265,10 @@ def make_homing_run(
     }
     if learner is not None:
         task["learner"] = learner
-    chosen_agent = load_agent(agent, allow_imports, policy=policy_kwargs)
-    env = make_agent_env(chosen_agent, tracker=tracker, keep_image=keep_image, **task)
-    acting = chosen_agent.policy(env)
+    if isinstance(loaded, ScriptedHomingAgent):
+        loaded = ScriptedHomingAgent(**policy_kwargs)
+    env = make_agent_env(loaded, tracker=tracker, keep_image=keep_image, **task)
+    acting = loaded.policy(env)
     return HomingRun(env, acting.predict, acting.reset)
 
 

@@ -301,8 +301,8 @@ OPTIONS: dict[str, Option] = {
         "mode",
         "--mode",
         "how the place is learned and the scripted agent homes (default: check-home; "
-        "paper for a learned agent, whose training places were learned the paper's way): "
-        + HOMING_MODE_HELP,
+        "for a learned agent the mode its training places were learned in, from its "
+        "config.json: paper for the shipped one): " + HOMING_MODE_HELP,
         choices=HOMING_MODE_CHOICES,
     ),
     "modes": Option(

@@ -23,6 +23,7 @@ import numpy as np
 
 from vc_gym.config_files import read_settings
 from vc_gym.envs.homing import LEARNED_CONFIRM_STOP_M, home_offset
+from vc_gym.envs.homing_modes import LEARNED_AGENT_MODE, canonical_homing_mode, homing_mode
 from vc_gym.localization import make_tracker
 from vc_gym.localization.registry import TRACKERS
 from vc_gym.plugins import check_file_spec, check_plain_data
@@ -49,8 +50,9 @@ __all__ = [
 CONFIG_SCHEMA = 2
 #: Warm-start episodes of each algorithm by default (``TrainConfig.demo_episodes``).
 DEFAULT_DEMO_EPISODES = {"ppo": 60, "sac": 0}
-#: Expert episodes that measure the goal correction by default
-#: (``TrainConfig.home_offset_episodes``; then centred, ``home_offset_centre``).
+#: Expert episodes that measure the goal correction by default in the paper's mode
+#: (``TrainConfig.home_offset_episodes``; then centred, ``home_offset_centre``); the other
+#: modes normalise the spots at the true home and measure none by default.
 DEFAULT_HOME_OFFSET_EPISODES = 10
 #: Learning and kidnapping seeds of the offset measurement start here: apart from the
 #: training envs' (seed + i), the held-out evaluations' (``eval_seed``) and the learning
@@ -117,6 +119,18 @@ class TrainConfig:
         ``seed``.
     scene : str
         Scene of ``vc_gym/LearnThenHome-v0``.
+    mode : str
+        The homing mode whose places the run learns and whose tracker it homes on
+        (:data:`~vc_gym.envs.homing_modes.HOMING_MODES`; its ``learning`` settings
+        become arguments of the agent's env, so that every evaluation learns its places
+        the same way). Default :data:`~vc_gym.envs.homing_modes.LEARNED_AGENT_MODE`
+        (``"pose-home"``: turns learned around the spots, normalised at the true home,
+        the ``pose-grid`` tracker); a ``config.json`` without this field reads as
+        ``"paper"``.
+    position_std : bool
+        The policy also sees the tracker's position spread (``position_std`` of
+        ``vc_gym/Homing-v0``), so that it can learn when to trust the position. Default
+        True; a ``config.json`` without this field reads as False.
     learn_time_s, success_radius_m, max_homing_s : float
         Task parameters (see ``LearnThenHomeEnv``).
     stop_time_s : float
@@ -152,9 +166,10 @@ class TrainConfig:
         true position`` at its stops becomes the goal of the agent's env
         (``home_offset_m`` of ``vc_gym/Homing-v0``; :mod:`vc_gym.training.home_offset`;
         ``DIR/home_offset.json``): the policy learns to stop where that error says the
-        true home is, not where the tracker believes home is. Default 10; 0: the
-        atlas' home (then ``home_offset_centre=False``). A ``config.json`` without this
-        field reads as 0.
+        true home is, not where the tracker believes home is. Default (``None``): 10 in
+        the ``"paper"`` mode, whose spots are normalised where the walk back's odometry
+        ends, 0 in the others (normalised at the true home); 0: the atlas' home (then
+        ``home_offset_centre=False``). A ``config.json`` without this field reads as 0.
     home_offset_places : int
         Places learned only for that measurement (learning seeds
         ``HOME_OFFSET_SEED + 16 × seed + k``, ``DIR/home-offset-place<s>.npz``): part of
@@ -165,8 +180,8 @@ class TrainConfig:
         home: the expert homes again on the same kidnappings going to it, and a secant
         step per axis moves the goal
         (:func:`~vc_gym.training.home_offset.centre_home_offset`; twice the expert
-        episodes; needs ``home_offset_episodes``). Default ``True``; a ``config.json``
-        without this field reads as ``False``.
+        episodes; needs ``home_offset_episodes``). Default (``None``): whether the
+        offset is measured; a ``config.json`` without this field reads as ``False``.
     home_offset_m : (float, float), optional
         The goal correction itself (metres, world frame). ``None`` (default): measured
         with ``home_offset_episodes``, or ``(0, 0)`` without; a run's ``config.json``
@@ -196,13 +211,14 @@ class TrainConfig:
         Walking speed (m/s) of a full forward action.
     max_turn_deg_s : float
         Turn rate (deg/s) of a full turn action.
-    tracker : str or dict
-        Tracker of the agent's env: a registered name (``"grid"``, ``"particle"``,
-        ``"kalman"``, any ``register_tracker`` name) or ``{"type": name, **kwargs}`` with
-        plain-data arguments (kept as a plain dict, so ``config.json`` stays JSON). From
-        Python code or the command line the name may also be an import path
-        ``"package.module:factory"``; from a file only with ``allow_imports``
-        (:func:`read_train_config`).
+    tracker : str or dict, optional
+        Tracker of the agent's env (default ``None``: the mode's,
+        :attr:`~vc_gym.envs.homing_modes.HomingMode.tracker`): a registered name
+        (``"grid"``, ``"particle"``, ``"kalman"``, any ``register_tracker`` name) or
+        ``{"type": name, **kwargs}`` with plain-data arguments (kept as a plain dict, so
+        ``config.json`` stays JSON). From Python code or the command line the name may
+        also be an import path ``"package.module:factory"``; from a file only with
+        ``allow_imports`` (:func:`read_train_config`).
     eval_freq : int
         Decisions between evaluations on held-out kidnappings (0: none). The model with
         the best mean return is kept as ``best/best_model.zip``.
@@ -228,15 +244,17 @@ class TrainConfig:
     seed: int = 0
     places: tuple[int, ...] = ()
     scene: str = "robolab"
+    mode: str = LEARNED_AGENT_MODE
+    position_std: bool = True
     learn_time_s: float = 5.0
     stop_time_s: float = 5.0
     confirm_stop_m: float | None = LEARNED_CONFIRM_STOP_M
     closeness_bonus: float = 0.0
     min_walk_m: float = 0.0
     previous_action: bool = True
-    home_offset_episodes: int = DEFAULT_HOME_OFFSET_EPISODES
+    home_offset_episodes: int | None = None
     home_offset_places: int = 3
-    home_offset_centre: bool = True
+    home_offset_centre: bool | None = None
     home_offset_m: tuple[float, float] | None = None
     success_radius_m: float = 0.3
     max_homing_s: float = 60.0
@@ -250,7 +268,7 @@ class TrainConfig:
     log_std_init: float = -0.5
     max_forward: float = 0.4
     max_turn_deg_s: float = 60.0
-    tracker: str | dict[str, Any] = "grid"
+    tracker: str | dict[str, Any] | None = None
     eval_freq: int = 20_000
     eval_episodes: int = 10
     eval_seed: int = 1_000_000
@@ -266,6 +284,15 @@ class TrainConfig:
             raise ValueError(f"algo must be one of {ALGORITHMS}, got {self.algo!r}")
         if self.demo_episodes is None:
             object.__setattr__(self, "demo_episodes", DEFAULT_DEMO_EPISODES[self.algo])
+        object.__setattr__(self, "mode", canonical_homing_mode(self.mode))
+        if self.tracker is None:
+            object.__setattr__(self, "tracker", homing_mode(self.mode).tracker)
+        if self.home_offset_episodes is None:
+            measured = self.mode == "paper" and self.home_offset_m is None
+            episodes = DEFAULT_HOME_OFFSET_EPISODES if measured else 0
+            object.__setattr__(self, "home_offset_episodes", episodes)
+        if self.home_offset_centre is None:
+            object.__setattr__(self, "home_offset_centre", bool(self.home_offset_episodes))
         for name, minimum in _INT_FIELDS.items():
             object.__setattr__(self, name, int_at_least(name, getattr(self, name), minimum))
         for name, maximum in (("n_envs", MAX_N_ENVS), ("home_offset_places", MAX_PLACES)):
@@ -284,7 +311,7 @@ class TrainConfig:
         if not (0 < gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1], got {self.gamma!r}")
         object.__setattr__(self, "gamma", gamma)
-        for name in ("previous_action", "home_offset_centre"):
+        for name in ("previous_action", "home_offset_centre", "position_std"):
             object.__setattr__(self, name, flag(name, getattr(self, name)))
         if not isinstance(self.scene, str) or not self.scene:
             raise ValueError(f"scene must be a scene name (a string), got {self.scene!r}")
@@ -383,6 +410,8 @@ class TrainConfig:
             checked["home_offset_m"] = list(self.home_offset_m)
         if self.previous_action:
             checked["previous_action"] = True
+        if self.position_std:
+            checked["position_std"] = True
         return {
             "scene": self.scene,
             "learn_time_s": self.learn_time_s,
@@ -392,6 +421,7 @@ class TrainConfig:
             "max_forward": self.max_forward,
             "max_turn_deg_s": self.max_turn_deg_s,
             "tracker": _plain_copy(self.tracker),
+            **homing_mode(self.mode).learning,
             **checked,
         }
 
@@ -401,7 +431,8 @@ class TrainConfig:
 
         A field missing from a saved config reads as the value that turns its feature
         off (final stops, no closeness bonus or minimum walk, no previous action, the
-        tracker's home, lockstep rollouts), not as the field's default; each field of
+        tracker's home, lockstep rollouts, the paper's mode, no position spread), not as
+        the field's default; each field of
         :class:`TrainConfig` says which.
         """
         data = dict(data)
@@ -417,6 +448,8 @@ class TrainConfig:
         data.setdefault("home_offset_places", 0)
         data.setdefault("home_offset_centre", False)
         data.setdefault("collector", "lockstep")
+        data.setdefault("mode", "paper")
+        data.setdefault("position_std", False)
         config = cls.from_settings(data)
         if env is not None and env != config.env_kwargs():
             raise ValueError("the config's 'env' does not match its own fields")

@@ -52,3 +52,26 @@ def test_the_paired_comparison_counts_distance_and_homing_time():
     lines = "\n".join(summary_lines(out))
     assert "mean homing time 12.3 s" in lines and "1 timed out" in lines
     assert "at least as fast in 2/3" in lines and "0.62 × the scripted agent's" in lines
+
+
+def test_learned_agents_of_different_modes_need_a_mode(monkeypatch, tmp_path):
+    from vc_gym.experiments.studies import agents as study
+
+    modes = {"pretrained": "paper", str(tmp_path / "b" / "model.zip"): "pose-home"}
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "model.zip").write_bytes(b"")
+    monkeypatch.setattr(study, "LearnedHomingAgent", lambda path, allow: path)
+    monkeypatch.setattr(
+        study,
+        "default_homing_mode",
+        lambda path: modes["pretrained" if path == str(study.PRETRAINED_MODEL) else path],
+    )
+    assert study._learned_mode(["scripted", "pretrained"], False) == "paper"
+    with pytest.raises(ValueError, match="different homing modes"):
+        study._learned_mode(["scripted", "pretrained", str(tmp_path / "b" / "model.zip")], False)
+    with pytest.raises(ValueError, match="different homing modes"):
+        study.run_agents(
+            tmp_path / "out",
+            agent=["scripted", "pretrained", str(tmp_path / "b" / "model.zip")],
+        )
+    assert not (tmp_path / "out").exists()  # refused before any work

@@ -109,8 +109,9 @@ EXPERIMENTS: dict[str, Experiment] = {
                 "atlas_dir",
                 "video",
                 mode="the places every agent homes in are learned this way, and the scripted "
-                "agent homes so (default: paper, the way the learned agents' training places "
-                "were learned): " + HOMING_MODE_HELP,
+                "agent homes so, on the mode's tracker (default: the mode the learned agents' "
+                "training places were learned in, from their config.json: paper for the "
+                "shipped one): " + HOMING_MODE_HELP,
             ),
         ),
         Experiment(

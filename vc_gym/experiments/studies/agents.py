@@ -22,7 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from vc_gym.experiments.episode import LEARNED_AGENT_MODE, canonical_homing_mode
+from vc_gym.agents.learned import PRETRAINED_MODEL, LearnedHomingAgent
+from vc_gym.experiments.episode import canonical_homing_mode, default_homing_mode
 from vc_gym.experiments.studies import get_experiment
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.kidnapping import PAPER_MEAN_CM, PAPER_STD_CM, mean_std
@@ -46,6 +47,26 @@ def agent_list(agent: str | Sequence[str]) -> list[str]:
         if a not in ("scripted", "pretrained") and not Path(a).is_file():
             raise ValueError(f"{a}: no such model file (expected DIR/model.zip from train)")
     return names
+
+
+def _learned_mode(agents: Sequence[str], allow_imports: bool) -> str:
+    """The homing mode the learned ``agents``' training places were learned in (one for
+    all of them, else a ``ValueError`` asking for ``mode``)."""
+    modes = {
+        a: default_homing_mode(LearnedHomingAgent(_model(a), allow_imports))
+        for a in agents
+        if a != "scripted"
+    }
+    if len(set(modes.values())) != 1:
+        raise ValueError(
+            f"the learned agents trained in places of different homing modes ({modes}); "
+            "name the mode to compare them in"
+        )
+    return next(iter(modes.values()))
+
+
+def _model(agent: str) -> str:
+    return str(PRETRAINED_MODEL) if agent == "pretrained" else agent
 
 
 def _labels(agents: Sequence[str]) -> list[str]:
@@ -85,10 +106,10 @@ def run_agents(
         comma-separated or a list. A learned agent's label is its folder's name.
     tracker, seeds, episodes, learn_time_s, max_homing_s, mode, allow_imports
         As :func:`~vc_gym.experiments.studies.homing.run_homing`. Every agent homes in
-        the same places, learned the ``mode``'s way (default
-        :data:`~vc_gym.experiments.episode.LEARNED_AGENT_MODE`, the way the learned
-        agents' training places were learned); only the scripted agent has a homing
-        policy mode.
+        the same places, learned the ``mode``'s way (default: the way the learned
+        agents' training places were learned, which must be one mode for all of them),
+        and the scripted agent homes with that mode's policy and tracker: the learned
+        agents are compared with the scripted agent of their own mode.
 
     Returns
     -------
@@ -96,8 +117,8 @@ def run_agents(
         The results written to ``results.json``.
     """
     opts = opts or ExperimentOptions()
-    mode = canonical_homing_mode(LEARNED_AGENT_MODE if mode is None else mode)
     agents = agent_list(agent)
+    mode = canonical_homing_mode(_learned_mode(agents, allow_imports) if mode is None else mode)
     labels = _labels(agents)
     out = check_out_dir(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -153,7 +153,8 @@ def run_homing(
         ``"scripted"``, ``"pretrained"`` or a learned agent's ``model.zip``.
     tracker : str or dict, optional
         The tracker of every episode (a name, ``"module:factory"`` or a dict); default
-        the mode's (``grid``; ``pose-grid`` for ``pose-home``).
+        a learned agent's own (the one it trained with), else the mode's (``grid``;
+        ``pose-grid`` for ``pose-home``).
     seeds : sequence of int, optional
         Learning seeds (default: ``[opts.seed]``); kidnapping ``i`` of seed ``s`` uses
         seed ``s + 1 + i`` (so ``vc-gym demo --seed s`` is its first episode).
@@ -174,7 +175,7 @@ def run_homing(
         ``"check-home"``, ``"paper"`` or ``"pose-home"`` (:data:`MODES`: how the place
         is learned, which tracker is the default and how the scripted agent homes). Default
         :func:`~vc_gym.experiments.episode.default_homing_mode`: check-home for the
-        scripted agent, paper for a learned one.
+        scripted agent, the mode of its training places for a learned one.
     sensor : str, optional
         An image sensor of :data:`vc_gym.heading_sensors.IMAGE_SENSORS` (``"feature"``,
         ``"image_difference"``, ...) as the grid tracker's heading sensor: for every
@@ -214,11 +215,8 @@ def run_homing(
         positive_float(name, v)
     if relearn not in ("scene", "episode"):
         raise ValueError(f"relearn must be 'scene' or 'episode', got {relearn!r}")
-    mode = canonical_homing_mode(default_homing_mode(agent) if mode is None else mode)
-    tracker = check_tracker_spec(MODES[mode].tracker if tracker is None else tracker)
-    if sensor is not None:
-        sensor = current_sensor_name(sensor)  # a deprecated name warns and is replaced
-        grid_options = _sensor_tracker_options(sensor, tracker, relearn)
+    if mode is not None:
+        mode = canonical_homing_mode(mode)
     if home_offset_m is not None:
         if agent != "scripted":
             raise ValueError(
@@ -235,8 +233,16 @@ def run_homing(
         learned = LearnedHomingAgent(agent, allow_imports)
         check_agent_env(learned, str(learned.config_path))  # and a config the env refuses
         scene = learned.scene
+        mode = default_homing_mode(learned) if mode is None else mode
+        own_tracker = learned.env_kwargs.get("tracker", MODES[mode].tracker)
     else:
         check_scene_name(scene)
+        mode = default_homing_mode(agent) if mode is None else mode
+        own_tracker = MODES[mode].tracker
+    tracker = check_tracker_spec(own_tracker if tracker is None else tracker)
+    if sensor is not None:
+        sensor = current_sensor_name(sensor)  # a deprecated name warns and is replaced
+        grid_options = _sensor_tracker_options(sensor, tracker, relearn)
 
     settings = {
         "agent": "scripted" if agent == "scripted" else Path(agent).parent.name,
