@@ -30,7 +30,6 @@ import numpy as np
 
 from vc_gym.deprecation import moved_names
 from vc_gym.jobs.output import check_out_dir, new_figure, save_figure, write_json
-from vc_gym.persistence import write_atomic
 from vc_gym.training import config as config_module
 from vc_gym.training import run_folder, safe_load
 from vc_gym.training.algorithms import algorithm_class
@@ -45,6 +44,7 @@ from vc_gym.training.environments import (
 from vc_gym.training.feature_expert import HomingFeatureExpert
 from vc_gym.training.home_offset import centre_home_offset, measure_home_offset
 from vc_gym.training.imitation import clone_behaviour, collect_demonstrations
+from vc_gym.training.model_file import save_reproducible_model
 from vc_gym.training.run_folder import (
     CHECKPOINT_PREFIX,
     RunStart,
@@ -307,7 +307,7 @@ def _train(
         if eval_env is not None:
             eval_env.close()
     model_path = out / "model.zip"
-    write_atomic(model_path, model.save)
+    save_reproducible_model(model, model_path)  # the same run gives the same bytes
     recent = episodes[-50:]
     rate, task_rate = log.decisions_per_s, log.task_steps_per_s
     summary = {
