@@ -37,6 +37,15 @@ def run(seeds: list[int], episodes: int, mode: str, variants: dict, cache: str) 
         )
         u = env.unwrapped
         where = HomingFeatures.position_std_slice(u.n_spots)
+        far_states: list = []
+        if hasattr(u.tracker, "far"):  # pose-grid: also record the pose belief's own state
+            update = u.tracker.far.update
+
+            def recorded(*args, _update=update, _states=far_states):
+                _states.append(_update(*args))
+                return _states[-1]
+
+            u.tracker.far.update = recorded
         for name, kwargs in variants.items():
             expert = HomingFeatureExpert(previous_action=True, **kwargs)
             rows = out.setdefault(name, [])
@@ -48,8 +57,12 @@ def run(seeds: list[int], episodes: int, mode: str, variants: dict, cache: str) 
                     stds.append(float(np.mean(obs[where])) * HomingFeatures.POSITION_STD_SCALE_M)
                     if term or trunc:
                         break
+                far = far_states[-1] if far_states else None
+                stop = info.get("stop_position", info["pose"][:2])
                 rows.append(
                     {
+                        "far_std_m": float(np.mean(far.position_std_m)) if far else math.nan,
+                        "far_error_m": float(math.dist(far.position, stop)) if far else math.nan,
                         "seed": seed,
                         "error_m": float(info.get("stop_error_m", math.nan)),
                         "success": bool(info.get("success", False)),
@@ -71,8 +84,8 @@ def main() -> None:
     p.add_argument("--out", default="expert_diagnostic.json")
     args = p.parse_args()
     variants = {
-        "paper rule": {},
         "fast": {"max_speed_m_s": 0.4},
+        "fast, 5 cm": {"max_speed_m_s": 0.4, "home_tolerance_m": 0.05},
     }
     seeds = [int(s) for s in args.seeds.split(",")]
     out = run(seeds, args.episodes, args.mode, variants, args.cache)
@@ -80,11 +93,14 @@ def main() -> None:
         err = np.array([r["error_m"] for r in rows])
         ok = np.array([r["success"] for r in rows])
         t = np.array([r["time_s"] for r in rows])
-        std = np.array([r["std_at_stop_m"] for r in rows])
+        std = np.array([r["far_std_m"] for r in rows])
+        far_err = np.array([r["far_error_m"] for r in rows])
+        print(f"  far error {np.nanmean(far_err):.2f} m; corr(far std, stop error) "
+              f"{np.corrcoef(std, err)[0, 1]:.2f}")
         print(
             f"{name:>12}: success {ok.mean():.0%}, mean stop {100 * np.nanmean(err):.1f} cm, "
             f"time {t.mean():.1f} s, timeouts {sum(r['timed_out'] for r in rows)}, "
-            f"std at stop: good {np.mean(std[ok]) if ok.any() else math.nan:.2f} m, "
+            f"far std at stop: good {np.mean(std[ok]) if ok.any() else math.nan:.2f} m, "
             f"bad {np.mean(std[~ok]) if (~ok).any() else math.nan:.2f} m"
         )
     Path(args.out).write_text(json.dumps(out, indent=1))

@@ -178,3 +178,15 @@ def test_mode_and_position_spread():
     before = {k: v for k, v in paper.to_dict().items() if k not in ("mode", "position_std")}
     old = TrainConfig.from_dict(before)
     assert old.mode == "paper" and old.position_std is False and old.tracker == "grid"
+
+
+def test_the_expert_walks_at_full_speed_by_default():
+    assert TrainConfig().expert_speed_m_s == 0.4 == TrainConfig().max_forward
+    assert TrainConfig(expert_speed_m_s=0.25).expert_speed_m_s == 0.25
+    for bad in (0.0, -0.1, float("nan"), "fast", 0.41):
+        with pytest.raises(ValueError, match="expert_speed_m_s"):
+            TrainConfig(expert_speed_m_s=bad)
+    assert TrainConfig(max_forward=0.3, expert_speed_m_s=0.3).expert_speed_m_s == 0.3
+    # a config.json saved before the field: the scripted agent's 0.25 m/s
+    before = {k: v for k, v in TrainConfig().to_dict().items() if k != "expert_speed_m_s"}
+    assert TrainConfig.from_dict(before).expert_speed_m_s == 0.25

@@ -39,6 +39,7 @@ _TRAIN_FIELDS = {
     "home_offset_centre": "home_offset_centre",
     "mode": "mode",
     "position_std": "position_std",
+    "expert_speed": "expert_speed_m_s",
 }
 
 
@@ -141,6 +142,13 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="warm start (ppo): clone the scripted expert's decisions in N homing episodes "
         "before PPO starts (DIR/warm_start.json; the clone is evaluated first); 0: from "
         "scratch, as with --algo sac (default 60)",
+    )
+    p.add_argument(
+        "--expert-speed",
+        type=float,
+        metavar="M_S",
+        help="fastest walk of the expert the warm start clones, m/s, at most the full walk "
+        "(default 0.4, the full walk; the scripted agent walks at 0.25)",
     )
     p.add_argument(
         "--closeness-bonus",

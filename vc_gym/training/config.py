@@ -92,6 +92,7 @@ _POSITIVE_FIELDS = (
     "learning_rate",
     "max_forward",
     "max_turn_deg_s",
+    "expert_speed_m_s",
 )
 
 
@@ -229,6 +230,12 @@ class TrainConfig:
     save_freq : int
         Decisions between checkpoints in ``checkpoints/`` (0: none); ``--resume DIR``
         continues from the latest that loads.
+    expert_speed_m_s : float
+        Fastest walk (m/s) of the scripted expert the policy is cloned from
+        (``max_speed_m_s`` of :class:`~vc_gym.agents.HomingFeatureExpert`), at most
+        ``max_forward``. Default 0.4, the full walk: the scripted agent's 0.25 m/s makes
+        the clone as slow as the scripted agent. A ``config.json`` without this field
+        reads as 0.25.
     demo_episodes : int
         Warm start (PPO only): episodes of the scripted expert
         (:class:`~vc_gym.agents.HomingFeatureExpert`) whose decisions the policy is
@@ -274,6 +281,7 @@ class TrainConfig:
     eval_seed: int = 1_000_000
     save_freq: int = 0
     demo_episodes: int | None = None
+    expert_speed_m_s: float = 0.4
 
     def __post_init__(self) -> None:
         # every field's type is checked here, whoever built the config (Python code, a
@@ -302,6 +310,11 @@ class TrainConfig:
             object.__setattr__(self, name, positive_float(name, getattr(self, name)))
         for name in ("closeness_bonus", "min_walk_m"):
             object.__setattr__(self, name, nonnegative_float(name, getattr(self, name)))
+        if self.expert_speed_m_s > self.max_forward:
+            raise ValueError(
+                f"expert_speed_m_s ({self.expert_speed_m_s}) must be at most max_forward "
+                f"({self.max_forward}), the speed of a full walk action"
+            )
         object.__setattr__(self, "log_std_init", finite_real("log_std_init", self.log_std_init))
         if self.confirm_stop_m is not None:
             object.__setattr__(
@@ -450,6 +463,7 @@ class TrainConfig:
         data.setdefault("collector", "lockstep")
         data.setdefault("mode", "paper")
         data.setdefault("position_std", False)
+        data.setdefault("expert_speed_m_s", 0.25)
         config = cls.from_settings(data)
         if env is not None and env != config.env_kwargs():
             raise ValueError("the config's 'env' does not match its own fields")

@@ -365,7 +365,10 @@ def _measure_goal(
 def _warm_start(model: Any, venv: Any, config: TrainConfig, progress: bool) -> dict[str, Any]:
     """Clone the scripted expert into ``model``'s policy (see :mod:`.imitation`)."""
     expert = HomingFeatureExpert(
-        config.max_forward, config.max_turn_deg_s, previous_action=config.previous_action
+        config.max_forward,
+        config.max_turn_deg_s,
+        previous_action=config.previous_action,
+        max_speed_m_s=config.expert_speed_m_s,
     )
     demos = collect_demonstrations(venv, expert, config.demo_episodes, config.gamma, progress)
     fit = clone_behaviour(model.policy, demos, seed=config.seed)
