@@ -35,3 +35,13 @@ def test_arguments_of_no_mode():
     assert mode_of_task({"around_m": 0.5}) is None  # turns around, normalised after the walk
     assert mode_of_task({"normalise_at": "start", "around_m": 0.3}) is None
     assert LEARNED_AGENT_MODE in HOMING_MODES
+
+
+@pytest.mark.parametrize("name", list(HOMING_MODES))
+def test_a_modes_task_learning_sets_every_setting_a_mode_may_change(name):
+    learning = HOMING_MODES[name].task_learning
+    assert set(learning) == set(_TASK_LEARNING_DEFAULTS)
+    assert mode_of_task(learning) == name
+    # it overrides another mode's settings, e.g. a learned agent's env arguments
+    for other in HOMING_MODES.values():
+        assert mode_of_task({**other.learning, **learning}) == name

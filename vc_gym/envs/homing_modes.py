@@ -49,6 +49,13 @@ class HomingMode:
     policy: dict[str, Any]
     tracker: TrackerSpec = "grid"
 
+    @property
+    def task_learning(self) -> dict[str, Any]:
+        """Every learning setting a mode may change, the task's own values where this
+        mode keeps them: task arguments that override whatever learning an env was
+        given (a learned agent's own), not only this mode's changes."""
+        return {**_TASK_LEARNING_DEFAULTS, **self.learning}
+
 
 #: The homing modes. ``paper``: the paper's procedure (5.2), normalising the spots
 #: after walking back home by odometry, whose drift (15-20 cm in the simulated robolab)
@@ -119,6 +126,6 @@ def mode_of_task(task_kwargs: Mapping[str, Any]) -> str | None:
     no mode. Arguments left out take the task's defaults, so ``{}`` is ``"paper"``."""
     settings = {k: task_kwargs.get(k, v) for k, v in _TASK_LEARNING_DEFAULTS.items()}
     for name, mode in HOMING_MODES.items():
-        if {**_TASK_LEARNING_DEFAULTS, **mode.learning} == settings:
+        if mode.task_learning == settings:
             return name
     return None

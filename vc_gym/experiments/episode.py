@@ -261,7 +261,7 @@ def make_homing_run(
         "stop_time_s": 5.0,  # the paper's rule, also for agents trained with a shorter one
         "success_radius_m": success_radius_m,
         "max_homing_s": max_homing_s,
-        **chosen.learning,
+        **chosen.task_learning,  # the mode's places, whatever a learned agent trained on
     }
     if learner is not None:
         task["learner"] = learner
