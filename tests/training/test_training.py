@@ -342,7 +342,8 @@ def test_previous_action_trains_a_policy_that_sees_its_last_action(tmp_path):
     assert summary["warm_start"]["demo_episodes"] == 1
     agent = LearnedHomingAgent(tmp_path / "model.zip")
     env = gym.make(agent.env_id, **agent.env_kwargs)
-    assert env.observation_space.shape == (15,)
+    # 8 features + 4 spots, the position's spread (2, on by default), the last action (3)
+    assert env.observation_space.shape == (8 + 4 + 2 + 3,)
     obs, _ = env.reset(seed=3)
     assert agent.predict(obs).shape == (3,)
     env.close()
