@@ -94,7 +94,7 @@ def test_shipped_policy_was_trained_with_the_default_settings():
     # the run measured its goal (centred); everything it was given is the defaults of the
     # paper's mode without the position's spread (the recipe before the pose-home default)
     assert shipped.home_offset_m is not None and max(map(abs, shipped.home_offset_m)) < 0.3
-    recipe = TrainConfig(seed=2, mode="paper", position_std=False, expert_speed_m_s=0.25)
+    recipe = TrainConfig(seed=2, mode="paper", position_std=False)
     assert replace(shipped, home_offset_m=None) == recipe
 
 

@@ -180,9 +180,9 @@ def test_mode_and_position_spread():
     assert old.mode == "paper" and old.position_std is False and old.tracker == "grid"
 
 
-def test_the_expert_walks_at_full_speed_by_default():
-    assert TrainConfig().expert_speed_m_s == 0.4 == TrainConfig().max_forward
-    assert TrainConfig(expert_speed_m_s=0.25).expert_speed_m_s == 0.25
+def test_the_expert_walks_at_the_scripted_agents_speed_by_default():
+    assert TrainConfig().expert_speed_m_s == 0.25
+    assert TrainConfig(expert_speed_m_s=0.4).expert_speed_m_s == 0.4 == TrainConfig().max_forward
     for bad in (0.0, -0.1, float("nan"), "fast", 0.41):
         with pytest.raises(ValueError, match="expert_speed_m_s"):
             TrainConfig(expert_speed_m_s=bad)

@@ -148,7 +148,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         type=float,
         metavar="M_S",
         help="fastest walk of the expert the warm start clones, m/s, at most the full walk "
-        "(default 0.4, the full walk; the scripted agent walks at 0.25)",
+        "(default 0.25, the scripted agent's)",
     )
     p.add_argument(
         "--closeness-bonus",

@@ -233,9 +233,9 @@ class TrainConfig:
     expert_speed_m_s : float
         Fastest walk (m/s) of the scripted expert the policy is cloned from
         (``max_speed_m_s`` of :class:`~vc_gym.agents.HomingFeatureExpert`), at most
-        ``max_forward``. Default 0.4, the full walk: the scripted agent's 0.25 m/s makes
-        the clone as slow as the scripted agent. A ``config.json`` without this field
-        reads as 0.25.
+        ``max_forward``. Default 0.25, the scripted agent's; PPO learns to walk faster
+        itself (a faster expert homed faster alone but trained a worse policy, see the
+        results notes). A ``config.json`` without this field reads as 0.25.
     demo_episodes : int
         Warm start (PPO only): episodes of the scripted expert
         (:class:`~vc_gym.agents.HomingFeatureExpert`) whose decisions the policy is
@@ -281,7 +281,7 @@ class TrainConfig:
     eval_seed: int = 1_000_000
     save_freq: int = 0
     demo_episodes: int | None = None
-    expert_speed_m_s: float = 0.4
+    expert_speed_m_s: float = 0.25
 
     def __post_init__(self) -> None:
         # every field's type is checked here, whoever built the config (Python code, a
