@@ -2,9 +2,10 @@
 
 For a few learning seeds, lets :class:`~vc_gym.training.HomingFeatureExpert` variants home
 on ``vc_gym/Homing-v0`` as ``vc-gym train`` builds it (its default mode, or ``--mode``) and
-prints, per variant, success within 30 cm, mean stop distance, mean homing time and the
-stated position spread at the stops that ended near and far from home. It is a diagnostic
-for choosing an expert to clone, not a command; its numbers are not results.
+prints, per variant, success within 30 cm, mean stop distance, mean homing time and, with
+the ``pose-grid`` tracker, the pose belief's own position spread and error at the stops
+that succeeded and that did not. It is a diagnostic for choosing an expert to clone, not a
+command; its numbers are not results.
 
     python scripts/expert_diagnostic.py --seeds 100,200 --episodes 12
 """
