@@ -212,13 +212,11 @@ def homing_spaces(env_kwargs: Mapping[str, Any]) -> tuple[spaces.Box, spaces.Box
     without building it: the features (:class:`~vc_gym.envs.HomingFeatures`) of the
     scripted learning's atlas (four spots, or 25 entries with ``around_m``), the
     position's spread with ``position_std``, the last action with ``previous_action``."""
-    around_m = env_kwargs.get("around_m", 0.0)
-    if isinstance(around_m, bool) or not isinstance(around_m, (int, float)):
-        raise ValueError(f"around_m must be a number of metres, got {around_m!r}")
-    n_spots = scripted_atlas_size(LearningConfig(around_m=float(around_m)))
+    # LearningConfig checks around_m (a number of metres, at most half the spot distance)
+    n_spots = scripted_atlas_size(LearningConfig(around_m=env_kwargs.get("around_m", 0.0)))
     n = HomingFeatures.GOODNESS_START + 1 + n_spots
     if env_kwargs.get("position_std", False):
-        n += 2
+        n += HomingFeatures.POSITION_STD_WIDTH
     if env_kwargs.get("previous_action", False):
         n += PreviousAction.WIDTH
     return (

@@ -108,6 +108,8 @@ class HomingFeatures(gym.ObservationWrapper):
     METRES_SCALE = 2.0
     SPREAD_SCALE_DEG = 180.0
     POSITION_STD_SCALE_M = 0.5
+    #: Entries the position's spread adds with ``position_std=True``: ``(x, y)``.
+    POSITION_STD_WIDTH = 2
 
     def __init__(
         self, env: gym.Env, home_offset_m: Any = (0.0, 0.0), position_std: bool = False
@@ -122,7 +124,7 @@ class HomingFeatures(gym.ObservationWrapper):
         if not isinstance(space, spaces.Dict) or not needed <= set(space.spaces):
             raise ValueError(f"HomingFeatures needs a CompassObservation env, got {space}")
         self.n_spots = space["goodness"].shape[0]
-        n = 8 + self.n_spots + (2 if self.position_std else 0)
+        n = 8 + self.n_spots + (self.POSITION_STD_WIDTH if self.position_std else 0)
         self.observation_space = spaces.Box(-10.0, 10.0, (n,), np.float32)
 
     @classmethod
@@ -130,7 +132,7 @@ class HomingFeatures(gym.ObservationWrapper):
         """Where the position's spread lies in a vector of ``n_spots`` spots with
         ``position_std=True``."""
         start = cls.GOODNESS_START + n_spots + 1
-        return slice(start, start + 2)
+        return slice(start, start + cls.POSITION_STD_WIDTH)
 
     def observation(self, obs: dict[str, np.ndarray]) -> np.ndarray:
         g = np.log(np.maximum(obs["goodness"].astype(np.float64), 1e-12)) / 5.0

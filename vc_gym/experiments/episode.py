@@ -44,6 +44,7 @@ __all__ = [
     "LEARNED_AGENT_MODE",
     "canonical_homing_mode",
     "default_homing_mode",
+    "default_tracker",
     "LEARNED_CONFIRM_STOP_M",
     "EpisodeRecord",
     "HomingMode",
@@ -198,6 +199,12 @@ def default_homing_mode(agent: Any) -> str:
     return mode
 
 
+def default_tracker(agent: HomingAgent, mode: str) -> TrackerSpec:
+    """The tracker ``agent`` homes on in homing mode ``mode`` unless told: a learned
+    agent's own (the one it trained with), else the mode's (:attr:`HomingMode.tracker`)."""
+    return agent.env_kwargs.get("tracker", homing_mode(mode).tracker)
+
+
 def make_homing_run(
     agent: str = "scripted",
     tracker: TrackerSpec | None = None,
@@ -250,9 +257,9 @@ def make_homing_run(
         that module; :class:`~vc_gym.agents.learned.LearnedHomingAgent`).
     """
     loaded = load_agent(agent, allow_imports)
-    chosen = homing_mode(default_homing_mode(loaded) if mode is None else mode)
-    if tracker is None:  # a learned agent homes on the tracker it trained with
-        tracker = loaded.env_kwargs.get("tracker", chosen.tracker)
+    mode = default_homing_mode(loaded) if mode is None else mode
+    chosen = homing_mode(mode)
+    tracker = default_tracker(loaded, mode) if tracker is None else tracker
     policy_kwargs = {**chosen.policy, **(policy or {})}
     task: dict[str, Any] = {
         "scene": scene,

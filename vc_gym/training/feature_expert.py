@@ -121,7 +121,7 @@ class HomingFeatureExpert:
         if self.max_position_std_m is None:
             return False
         # [features (8 + n_spots), spread (2), previous action (3)?]
-        n_spots = f.shape[0] - HomingFeatures.GOODNESS_START - 1 - 2
+        n_spots = f.shape[0] - HomingFeatures.GOODNESS_START - 1 - HomingFeatures.POSITION_STD_WIDTH
         n_spots -= PreviousAction.WIDTH if self.previous_action else 0
         if n_spots < 1:
             raise ValueError(

@@ -31,6 +31,8 @@ from vc_gym.experiments.episode import (
     canonical_homing_mode,
     check_agent_env,
     default_homing_mode,
+    default_tracker,
+    load_agent,
 )
 from vc_gym.experiments.spot_sensors import spot_sensor_job
 from vc_gym.experiments.studies import kidnapping
@@ -230,16 +232,14 @@ def run_homing(
     if agent != "scripted":
         agent = str(Path(agent).resolve())
         # a bad model fails here, not in a worker
-        learned = LearnedHomingAgent(agent, allow_imports)
-        check_agent_env(learned, str(learned.config_path))  # and a config the env refuses
-        scene = learned.scene
-        mode = default_homing_mode(learned) if mode is None else mode
-        own_tracker = learned.env_kwargs.get("tracker", MODES[mode].tracker)
+        loaded = LearnedHomingAgent(agent, allow_imports)
+        check_agent_env(loaded, str(loaded.config_path))  # and a config the env refuses
+        scene = loaded.scene
     else:
         check_scene_name(scene)
-        mode = default_homing_mode(agent) if mode is None else mode
-        own_tracker = MODES[mode].tracker
-    tracker = check_tracker_spec(own_tracker if tracker is None else tracker)
+        loaded = load_agent(agent)
+    mode = default_homing_mode(loaded) if mode is None else mode
+    tracker = check_tracker_spec(default_tracker(loaded, mode) if tracker is None else tracker)
     if sensor is not None:
         sensor = current_sensor_name(sensor)  # a deprecated name warns and is replaced
         grid_options = _sensor_tracker_options(sensor, tracker, relearn)
