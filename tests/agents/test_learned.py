@@ -28,13 +28,24 @@ def test_bad_model_files_are_clear_errors(tmp_path, capsys):
 
 def test_shipped_policy_loads_and_walks_towards_home_ahead():
     from vc_gym.agents.learned import PRETRAINED_MODEL
+    from vc_gym.envs.homing import HomingFeatures, PreviousAction
 
     agent = LearnedHomingAgent(PRETRAINED_MODEL)
     assert agent.algo == "ppo" and agent.scene == "robolab"
-    # home 1.5 m straight ahead, heading known (spread 9 deg), goodness as at home
-    features = np.array([0.75, 0.0, 1.0, 0.0, 0.05, -0.75, 0.0, 0, 0, 0, 0, 0.0], np.float32)
-    if agent.env_kwargs.get("previous_action"):  # and no action yet, as after a reset
-        features = np.concatenate([features, np.zeros(3, np.float32)])
+    n = agent.model.observation_space.shape[0]
+    position_std = bool(agent.env_kwargs.get("position_std"))
+    previous = PreviousAction.WIDTH if agent.env_kwargs.get("previous_action") else 0
+    n_spots = n - 8 - previous - (HomingFeatures.POSITION_STD_WIDTH if position_std else 0)
+    # home 1.5 m straight ahead, heading known (spread 9 deg), every spot's goodness 1, the
+    # head straight, no action yet (as after a reset)
+    features = np.zeros(n, np.float32)
+    features[HomingFeatures.HOME_VECTOR] = (0.75, 0.0)
+    features[HomingFeatures.HEADING] = (1.0, 0.0)
+    features[HomingFeatures.SPREAD] = 0.05
+    features[HomingFeatures.POSITION] = (-0.75, 0.0)
+    if position_std:  # the position known to 0.2 m
+        spread = HomingFeatures.position_std_slice(n_spots)
+        features[spread] = 0.2 / HomingFeatures.POSITION_STD_SCALE_M
     forward, _, stop = agent.predict(features)
     assert forward > 0.5 and stop <= 0.5
 
@@ -83,19 +94,13 @@ def test_env_arguments_the_env_refuses_name_the_config_file(tmp_path, capsys, ch
 
 
 def test_shipped_policy_was_trained_with_the_default_settings():
-    # README: the shipped policy is seed 2 of `vc-gym train --seeds 0,1,2 --workers 1`;
-    # a change of TrainConfig's defaults must re-ship it (or say why not)
-    from dataclasses import replace
-
+    # README: the shipped policy is `vc-gym train --seed 0`, byte for byte; a change of
+    # TrainConfig's defaults must re-ship it (or say why not)
     from vc_gym.agents.learned import PRETRAINED_MODEL
     from vc_gym.training.config import TrainConfig, read_train_config
 
     shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
-    # the run measured its goal (centred); everything it was given is the defaults of the
-    # paper's mode without the position's spread (the recipe before the pose-home default)
-    assert shipped.home_offset_m is not None and max(map(abs, shipped.home_offset_m)) < 0.3
-    recipe = TrainConfig(seed=2, mode="paper", position_std=False)
-    assert replace(shipped, home_offset_m=None) == recipe
+    assert shipped == TrainConfig(seed=0)
 
 
 def _copied_agent(tmp_path, change):

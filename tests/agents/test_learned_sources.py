@@ -4,14 +4,13 @@ config.json, an RL Zoo run folder, the model alone plus flags."""
 from __future__ import annotations
 
 import json
-import shutil
 from collections import OrderedDict
 
+import gymnasium as gym
 import pytest
 import yaml
 
 from vc_gym.agents.learned import (
-    PRETRAINED_MODEL,
     LearnedHomingAgent,
     homing_spaces,
     parse_env_kwargs,
@@ -20,13 +19,27 @@ from vc_gym.cli import main
 from vc_gym.training.zoo_run import read_zoo_file
 
 
+class _SpacesOnly(gym.Env):
+    """An env that only has ``vc_gym/Homing-v0``'s spaces, to build a policy for them."""
+
+    def __init__(self, env_kwargs):
+        self.observation_space, self.action_space = homing_spaces(env_kwargs)
+
+
+def _save_policy(path, env_kwargs):
+    """A fresh PPO policy of ``vc_gym/Homing-v0`` with ``env_kwargs``, saved to ``path``
+    as stable-baselines3 saves one (no config.json beside it)."""
+    from stable_baselines3 import PPO
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    PPO("MlpPolicy", _SpacesOnly(env_kwargs), n_steps=64, batch_size=32, seed=0).save(path)
+    return path
+
+
 @pytest.fixture
 def bare_model(tmp_path):
-    """The shipped PPO policy saved alone (no config.json): 15 features, previous action."""
-    path = tmp_path / "bare" / "homing_ppo.zip"
-    path.parent.mkdir()
-    shutil.copy(PRETRAINED_MODEL, path)
-    return path
+    """A PPO policy saved alone (no config.json): 15 features, previous action."""
+    return _save_policy(tmp_path / "bare" / "homing_ppo.zip", {"previous_action": True})
 
 
 def _zoo_run(tmp_path, env_kwargs, args=None, config=None):
@@ -34,7 +47,7 @@ def _zoo_run(tmp_path, env_kwargs, args=None, config=None):
     run = tmp_path / "logs" / "ppo" / "vc_gym-Homing-v0_1"
     params = run / "vc_gym-Homing-v0"
     params.mkdir(parents=True)
-    shutil.copy(PRETRAINED_MODEL, run / "vc_gym-Homing-v0.zip")
+    _save_policy(run / "vc_gym-Homing-v0.zip", {"previous_action": True})
     saved = OrderedDict([("batch_size", 64), ("env_kwargs", env_kwargs), *(config or {}).items()])
     (params / "config.yml").write_text(yaml.dump(saved))
     argv = OrderedDict([("algo", "ppo"), ("env", "vc_gym/Homing-v0"), *(args or {}).items()])

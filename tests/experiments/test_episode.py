@@ -100,7 +100,7 @@ def test_a_learned_agent_homes_in_the_mode_of_its_training_places():
     from vc_gym.experiments.episode import default_homing_mode, homing_mode
 
     assert default_homing_mode("scripted") == "check-home"
-    assert default_homing_mode(str(PRETRAINED_MODEL)) == "paper"  # trained on paper places
+    assert default_homing_mode(str(PRETRAINED_MODEL)) == "pose-home"  # its training places
     pose = SimpleNamespace(env_kwargs={**homing_mode("pose-home").learning}, path="m.zip")
     assert default_homing_mode(pose) == "pose-home"
     odd = SimpleNamespace(env_kwargs={"around_m": 0.3}, path="odd/model.zip")

@@ -83,7 +83,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         choices=HOMING_MODE_CHOICES,
         help="how the place is learned and the scripted agent homes (default: check-home; "
         "for a learned agent the mode its training places were learned in, from its "
-        "config.json: paper for the shipped one): " + HOMING_MODE_HELP,
+        "config.json: pose-home for the shipped one): " + HOMING_MODE_HELP,
     )
     add_tracker_option(p)
     p.add_argument(

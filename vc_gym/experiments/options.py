@@ -302,7 +302,7 @@ OPTIONS: dict[str, Option] = {
         "--mode",
         "how the place is learned and the scripted agent homes (default: check-home; "
         "for a learned agent the mode its training places were learned in, from its "
-        "config.json: paper for the shipped one): " + HOMING_MODE_HELP,
+        "config.json: pose-home for the shipped one): " + HOMING_MODE_HELP,
         choices=HOMING_MODE_CHOICES,
     ),
     "modes": Option(

@@ -110,8 +110,8 @@ EXPERIMENTS: dict[str, Experiment] = {
                 "video",
                 mode="the places every agent homes in are learned this way, and the scripted "
                 "agent homes so, on the mode's tracker (default: the mode the learned agents' "
-                "training places were learned in, from their config.json: paper for the "
-                "shipped one): " + HOMING_MODE_HELP,
+                "training places were learned in, from their config.json: pose-home for "
+                "the shipped one): " + HOMING_MODE_HELP,
             ),
         ),
         Experiment(
