@@ -98,9 +98,13 @@ def test_shipped_policy_was_trained_with_the_default_settings():
     # TrainConfig's defaults must re-ship it (or say why not)
     from vc_gym.agents.learned import PRETRAINED_MODEL
     from vc_gym.training.config import TrainConfig, read_train_config
+    from vc_gym.training.model_file import reproducible_model_bytes
 
     shipped = read_train_config(PRETRAINED_MODEL.parent / "config.json")
     assert shipped == TrainConfig(seed=0)
+    # and its model.zip is in the form vc-gym train writes, which a rerun reproduces
+    saved = PRETRAINED_MODEL.read_bytes()
+    assert reproducible_model_bytes(saved) == saved
 
 
 def _copied_agent(tmp_path, change):
