@@ -62,6 +62,17 @@ def test_a_model_saved_alone_is_read_from_its_weights_and_spaces(bare_model):
     assert agent.model.observation_space == homing_spaces({"previous_action": True})[0]
 
 
+def test_a_model_saved_alone_of_other_settings_needs_them_given(tmp_path):
+    from vc_gym.training.config import TrainConfig
+
+    kwargs = TrainConfig().env_kwargs()  # vc-gym train's default env: 38 features
+    path = _save_policy(tmp_path / "bare" / "default.zip", kwargs)
+    with pytest.raises(ValueError, match="observation space.*--env-kwargs"):
+        LearnedHomingAgent(path)
+    agent = LearnedHomingAgent(path, env_kwargs=kwargs)
+    assert agent.model.observation_space == homing_spaces(kwargs)[0]
+
+
 def test_flags_go_on_top_and_are_checked(bare_model):
     agent = LearnedHomingAgent(bare_model, env_kwargs={"confirm_stop_m": 0.25, "scene": "office"})
     assert agent.env_kwargs == {"confirm_stop_m": 0.25, "scene": "office", "previous_action": True}

@@ -347,9 +347,16 @@ class LearnedHomingAgent:
             ("action", self.model.action_space, want_act),
         ):
             if not _same_box(got, want):
+                hint = (
+                    "; nothing beside the model says how its env was built: give its "
+                    "arguments (--env-kwargs, or env_kwargs=; vc-gym train keeps them "
+                    "under 'env' in its config.json)"
+                    if self.settings_source == "model"
+                    else ""
+                )
                 raise ValueError(
                     f"{self.path}: the model's {what} space is {got}, but vc_gym/Homing-v0 "
-                    f"with {self.env_kwargs} has {want}"
+                    f"with {self.env_kwargs} has {want}{hint}"
                 )
 
     @property
