@@ -1,16 +1,28 @@
 """Shared fixtures: seeded synthetic scenes, the optional real photo folder, and a place
-cache of the test session's own."""
+cache of the test session's own; hypothesis' profiles.
+
+Hypothesis runs the ``default`` profile: a small, derandomised search without deadlines
+(the same examples every run, on any machine's speed). ``VC_GYM_HYPOTHESIS=thorough``
+searches ten times as many random examples.
+"""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
 from vc_gym.experiments.real_data import default_real_data_dir
 from vc_gym.worlds.panorama import Panorama, render_view
 from vc_gym.worlds.panorama_painters import make_panorama
 from vc_gym.worlds.room import Room, make_room, render_room_view
+
+settings.register_profile("default", max_examples=50, derandomize=True, deadline=None)
+settings.register_profile("thorough", max_examples=500, derandomize=False, deadline=None)
+settings.load_profile(os.environ.get("VC_GYM_HYPOTHESIS", "default"))
 
 #: Yaws of the learning frames: 8 body directions x 3 head pans (paper 4.3).
 LEARN_YAWS = [body + pan for body in range(0, 360, 45) for pan in (-22.5, 0.0, 22.5)]

@@ -10,7 +10,9 @@ from vc_gym.validation import (
     flag,
     int_at_least,
     nonnegative_float,
+    nonnegative_float_at_most,
     positive_float,
+    positive_float_at_most,
 )
 
 
@@ -74,3 +76,21 @@ def test_flag_takes_only_true_or_false():
     for bad in (1, 0, "yes", None, 1.0):
         with pytest.raises(ValueError, match="x must be True or False"):
             flag("x", bad)
+
+
+def test_bounded_floats_take_their_bound_and_name_it_with_the_unit():
+    assert positive_float_at_most("t", 60, 60.0, "seconds") == 60.0
+    assert nonnegative_float_at_most("t", 0, 60.0, "seconds") == 0.0
+    assert nonnegative_float_at_most("t", 60, 60.0) == 60.0
+    with pytest.raises(ValueError, match=r"^t must be in \(0, 60\] seconds, got 60\.5$"):
+        positive_float_at_most("t", 60.5, 60.0, "seconds")
+    with pytest.raises(ValueError, match=r"^t must be in \[0, 60\] seconds, got 1e\+20$"):
+        nonnegative_float_at_most("t", 1e20, 60.0, "seconds")
+    with pytest.raises(ValueError, match=r"^t must be in \(0, 60\], got 61$"):
+        positive_float_at_most("t", 61, 60.0)
+
+
+@pytest.mark.parametrize("value", [-1.0, float("nan"), float("inf"), "5", True])
+def test_nonnegative_float_at_most_refuses_what_nonnegative_float_refuses(value):
+    with pytest.raises(ValueError, match="^t must be (finite|a real number)"):
+        nonnegative_float_at_most("t", value, 60.0)

@@ -106,6 +106,13 @@ def read_json_array(arrays: Mapping[str, np.ndarray], key: str, path: str | os.P
         raise MapFileError(f"{path}: entry {key!r} is nested too deeply") from None
 
 
+def _not_a_file(path: Path) -> str:
+    """Why ``path``, which is not a regular file, cannot be read as one."""
+    if path.is_dir():
+        return "a folder, not a file"
+    return "not a regular file" if path.exists() else "no such file"
+
+
 def save_npz_atomic(
     path: str | os.PathLike, schema: str, version: int, arrays: Mapping[str, np.ndarray]
 ) -> Path:
@@ -201,7 +208,7 @@ def load_npz_checked(
     """
     path = Path(path)
     if not path.is_file():
-        raise MapFileError(f"{path}: no such file")
+        raise MapFileError(f"{path}: {_not_a_file(path)}")
     if path.stat().st_size == 0:
         raise MapFileError(f"{path}: file is empty")
     try:

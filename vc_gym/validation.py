@@ -13,7 +13,9 @@ __all__ = [
     "MAX_ABS_DEG",
     "MAX_ABS_METRES",
     "MAX_EPISODES",
+    "MAX_HALF_LIFE_S",
     "MAX_HOMING_S",
+    "MAX_LEARNING_PHASE_S",
     "MAX_LEARN_TIME_S",
     "MAX_SEED",
     "MAX_SEEDS",
@@ -26,6 +28,7 @@ __all__ = [
     "int_at_least",
     "int_in_range",
     "nonnegative_float",
+    "nonnegative_float_at_most",
     "positive_float",
     "positive_float_at_most",
 ]
@@ -44,11 +47,23 @@ MAX_SEED = 2**32 - 1
 MAX_EPISODES = 10_000
 #: Most learning seeds (or training seeds) one command takes.
 MAX_SEEDS = 1_000
-#: Longest learning time per direction (s): 12 times the paper's 5 s; the scripted
-#: learning of 4 spots x 8 directions then takes 32 simulated minutes.
+#: Longest learning time per direction (s; ``learn_time_s``): 12 times the paper's 5 s;
+#: the scripted learning of 4 spots x 8 directions then takes 32 simulated minutes.
 MAX_LEARN_TIME_S = 60.0
-#: Longest homing time limit (s): an hour, 60 times the paper's minute.
+#: Longest homing time limit (s; ``max_homing_s``): an hour, 60 times the paper's
+#: minute. It also bounds the task's ``stop_time_s`` and ``vc_gym/Homing-v0``'s
+#: ``min_walk_s``: a stop, or a walk before stops count, longer than the longest homing
+#: could never end an episode.
 MAX_HOMING_S = 3600.0
+#: Longest learning phase of an agent that learns the place itself (s;
+#: ``max_learning_s`` with ``learning="agent"``): an hour, as long as the longest
+#: homing and 12 times the default 300 s.
+MAX_LEARNING_PHASE_S = 3600.0
+#: Longest mixing half-life (s) of the heading filter of the scripted learning phase
+#: (``LearningConfig.half_life_s``): 200 times the paper's 0.3 s and as long as the
+#: longest learning time per direction; at a 0.1 s step the filter then replaces 0.1 %
+#: of its belief a step, which is no mixing to speak of.
+MAX_HALF_LIFE_S = 60.0
 
 
 def finite_float(name: str, value: object) -> float:
@@ -249,10 +264,27 @@ def check_reset_options(options: object, known: Collection[str]) -> dict[str, An
     return dict(options)
 
 
-def positive_float_at_most(name: str, value: object, maximum: float) -> float:
+def positive_float_at_most(name: str, value: object, maximum: float, unit: str = "") -> float:
     """``float(value)`` for a finite real number in ``(0, maximum]``, else a
-    ``ValueError`` naming ``name`` and the range (strings and bools are refused)."""
+    ``ValueError`` naming ``name`` and the range (strings and bools are refused).
+
+    ``unit`` (e.g. ``"seconds"``) follows the range in the message:
+    ``"learn_time_s must be in (0, 60] seconds, got 1000.0"``."""
     v = positive_float(name, value)
     if v > maximum:
-        raise ValueError(f"{name} must be in (0, {maximum:g}], got {value!r}")
+        raise ValueError(f"{name} must be in (0, {maximum:g}]{_unit(unit)}, got {value!r}")
     return v
+
+
+def nonnegative_float_at_most(name: str, value: object, maximum: float, unit: str = "") -> float:
+    """``float(value)`` for a finite real number in ``[0, maximum]``, else a
+    ``ValueError`` naming ``name`` and the range (strings and bools are refused);
+    ``unit`` as for :func:`positive_float_at_most`."""
+    v = nonnegative_float(name, value)
+    if v > maximum:
+        raise ValueError(f"{name} must be in [0, {maximum:g}]{_unit(unit)}, got {value!r}")
+    return v
+
+
+def _unit(unit: str) -> str:
+    return f" {unit}" if unit else ""

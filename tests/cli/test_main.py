@@ -54,3 +54,29 @@ def test_a_zero_default_is_shown():
     parser = cli.build_parser()
     demo = parser._subparsers._group_actions[0].choices["demo"]
     assert "(default: 0)" in " ".join(demo.format_help().split())
+
+
+def test_sigterm_runs_the_ctrl_c_cleanup_and_is_one_line(monkeypatch, capsys, tmp_path):
+    import os
+    import signal
+
+    from vc_gym.jobs.output import new_out_dir
+
+    def terminated_while_working(args):
+        with new_out_dir(tmp_path / "run"):
+            os.kill(os.getpid(), signal.SIGTERM)
+            raise AssertionError("SIGTERM was not heard")
+
+    def parser():
+        import argparse
+
+        p = argparse.ArgumentParser()
+        p.set_defaults(func=terminated_while_working, command="demo")
+        return p
+
+    before = signal.getsignal(signal.SIGTERM)
+    monkeypatch.setattr(cli, "build_parser", parser)
+    assert cli.main([]) == cli.EXIT_TERMINATED == 143
+    assert capsys.readouterr().err == "vc-gym demo: terminated (SIGTERM)\n"
+    assert not (tmp_path / "run").exists()  # the folder it made is gone again
+    assert signal.getsignal(signal.SIGTERM) is before  # the caller's handler is back

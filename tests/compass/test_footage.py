@@ -15,12 +15,14 @@ import pytest
 from vc_gym.compass import Camera, CompassConfig
 from vc_gym.compass.footage import (
     MAX_FRAME_PIXELS,
+    BadFrameError,
     Footage,
     FootageTrack,
     VideoSink,
     draw_estimate,
     footage_camera,
     footage_yaws,
+    image_file_problem,
     image_file_size,
     learn_footage,
     read_yaw_csv,
@@ -302,7 +304,7 @@ def test_corrupt_and_mixed_images_are_refused(tmp_path):
     data = (cut / "frame1.png").read_bytes()
     (cut / "frame1.png").write_bytes(data[: len(data) // 2])
     footage = Footage(cut)  # the header is whole: the damage shows when decoding
-    with pytest.raises(ValueError, match=r"frame1.png: cannot be decoded"):
+    with pytest.raises(BadFrameError, match=r"frame1.png: the PNG ends before its image"):
         list(footage.frames())
     mixed = write_folder(tmp_path / "mixed", [good, np.zeros((24, 30, 3), np.uint8)])
     with pytest.raises(ValueError, match="different sizes"):
@@ -316,6 +318,69 @@ def test_huge_frames_are_refused_before_decoding(tmp_path):
     assert image_file_size(folder / "a.png") == (100_000, 100_000)
     with pytest.raises(ValueError, match=f"larger than {MAX_FRAME_PIXELS:,} pixels"):
         Footage(folder)
+
+
+def test_width_is_refused_where_the_scaled_frame_passes_the_pixel_limit(tmp_path):
+    # 96x96 frames scaled to 16384 wide would be 268 megapixels: refused before decoding
+    folder = write_folder(tmp_path / "small", [np.zeros((96, 96, 3), np.uint8)] * 2)
+    with pytest.raises(ValueError, match=r"width 16384: frames of 96x96 pixels would be"):
+        Footage(folder, width=16384)
+    with pytest.raises(ValueError, match=r"--width 16384: .* at most 7071"):
+        Footage(folder, width=16384, names={"width": "--width"})
+    footage = Footage(folder, width=7071)  # the widest that fits
+    assert footage.frame_size == (7071, 7071)
+    assert 7071 * 7071 <= MAX_FRAME_PIXELS < 7072 * 7072
+    tall = write_folder(tmp_path / "tall", [np.zeros((400, 20, 3), np.uint8)])
+    with pytest.raises(ValueError, match="more than 50,000,000 pixels"):
+        Footage(tall, width=2000)  # 2000 x 40000
+
+
+def truncated(data: bytes, share: float = 0.7) -> bytes:
+    return data[: int(len(data) * share)]
+
+
+@pytest.mark.parametrize("suffix", [".jpg", ".png", ".bmp"])
+def test_a_truncated_image_is_a_bad_frame_named_or_skipped(room_pano, tmp_path, suffix):
+    frames = views(room_pano, [0.0, 30.0, 60.0])
+    folder = write_folder(tmp_path / "f", frames, name="frame{}" + suffix)
+    whole = (folder / f"frame1{suffix}").read_bytes()
+    assert image_file_problem(whole) is None
+    (folder / f"frame1{suffix}").write_bytes(truncated(whole))
+    assert "truncated" in image_file_problem(truncated(whole))
+    with pytest.raises(
+        BadFrameError, match=rf"frame1\{suffix}: .*truncated.*skip_bad_frames=True leaves"
+    ):
+        list(Footage(folder).frames())
+    footage = Footage(folder, skip_bad_frames=True)
+    assert [i for i, _ in footage.frames()] == [0, 2]
+    assert list(footage.skipped) == [1] and "truncated" in footage.skipped[1]
+
+
+def test_skipped_frames_have_no_row_and_are_counted(turn_compass, room_pano, tmp_path):
+    frames = views(room_pano, OTHER_YAWS[:4])
+    folder = write_folder(tmp_path / "f", frames, name="f{}.jpg")
+    (folder / "f2.jpg").write_bytes(truncated((folder / "f2.jpg").read_bytes()))
+    footage = Footage(folder, skip_bad_frames=True)
+    track = track_footage(turn_compass, footage, Camera(hfov_deg=HFOV), OTHER_YAWS[:4])
+    assert track.indices.tolist() == [0, 1, 3] and track.skipped == 1
+    np.testing.assert_allclose(track.true_deg, OTHER_YAWS[[0, 1, 3]])
+    summary = track.summary()
+    assert summary["frames"] == 3 and summary["skipped_frames"] == 1
+    assert summary["median_abs_error_deg"] < 3.0
+
+
+def test_a_focal_length_outside_the_field_of_view_range_names_the_flag(tmp_path):
+    folder = write_folder(tmp_path / "f", [np.zeros((96, 96, 3), np.uint8)])
+    footage = Footage(folder)
+    names = {"focal_px": "--focal", "hfov_deg": "--hfov"}
+    with pytest.raises(ValueError, match=r"^--focal 1e-300: .* would see 180 degrees"):
+        footage_camera(footage, focal_px=1e-300, names=names)
+    with pytest.raises(ValueError, match=r"^--focal 1e\+06: .*\[1, 179\] degrees"):
+        footage_camera(footage, focal_px=1e6, names=names)
+    with pytest.raises(ValueError, match=r"^--hfov must be in \[1, 179\]"):
+        footage_camera(footage, hfov_deg=1e-300, names=names)
+    cam = footage_camera(footage, focal_px=48.0, names=names)
+    assert cam.hfov_deg == pytest.approx(90.0)
 
 
 def test_image_sizes_from_headers(tmp_path):

@@ -1,5 +1,6 @@
 """Every env refuses an action that is not a finite real array of its action space's
-shape, and reset options that are not a dict, with a ValueError naming what it takes."""
+shape, reset options that are not a dict, and a time argument beyond its bound, with a
+ValueError naming what it takes."""
 
 from __future__ import annotations
 
@@ -11,9 +12,17 @@ from gymnasium import spaces
 import vc_gym  # noqa: F401  (registers the envs)
 from vc_gym.envs import PlacePool
 from vc_gym.envs.homing import PreviousAction, StopAction
-from vc_gym.envs.learning import LearningResult
+from vc_gym.envs.learn_then_home import make_task
+from vc_gym.envs.learning import LearningConfig, LearningResult
 from vc_gym.sim.head_camera import HeadCameraSpec
-from vc_gym.validation import check_action, check_reset_options
+from vc_gym.validation import (
+    MAX_HALF_LIFE_S,
+    MAX_HOMING_S,
+    MAX_LEARN_TIME_S,
+    MAX_LEARNING_PHASE_S,
+    check_action,
+    check_reset_options,
+)
 
 SMALL = HeadCameraSpec(52, 40, 56.9)
 
@@ -190,3 +199,88 @@ def test_place_pool_refuses_bad_box_actions(name):
     with pytest.raises(ValueError, match="action must be"):
         pool.step(bad_actions(3)[name])
     pool.step(np.zeros(3, np.float32))
+
+
+# --------------------------------------------------------------------- time limits
+TASKS = ["vc_gym/LearnThenHome-v0", "vc_gym/Homing-v0"]
+
+
+def _just_above(bound: float) -> float:
+    return bound * (1 + 1e-9)
+
+
+#: Time arguments beyond their bound, and the start of the message each gives. The
+#: first two are the issue's repros: ``reset`` of the first never returned.
+TOO_LONG = {
+    "learn_time_s=1e12": (
+        {"learn_time_s": 1e12, "max_homing_s": 5.0},
+        r"learn_time_s must be in \(0, 60\] seconds, got 1000000000000\.0",
+    ),
+    "max_homing_s=1e12": (
+        {"max_homing_s": 1e12},
+        r"max_homing_s must be in \(0, 3600\] seconds, got 1000000000000\.0",
+    ),
+    "learn_time_s above": (
+        {"learn_time_s": _just_above(MAX_LEARN_TIME_S)},
+        r"learn_time_s must be in \(0, 60\] seconds",
+    ),
+    "max_homing_s above": (
+        {"max_homing_s": _just_above(MAX_HOMING_S)},
+        r"max_homing_s must be in \(0, 3600\] seconds",
+    ),
+    "stop_time_s above": (
+        {"stop_time_s": _just_above(MAX_HOMING_S)},
+        r"stop_time_s must be in \(0, 3600\] seconds",
+    ),
+    "max_learning_s above": (
+        {"max_learning_s": _just_above(MAX_LEARNING_PHASE_S)},
+        r"max_learning_s must be in \(0, 3600\] seconds",
+    ),
+}
+
+#: Every time argument at its bound.
+AT_BOUND = {
+    "learn_time_s": MAX_LEARN_TIME_S,
+    "max_homing_s": MAX_HOMING_S,
+    "stop_time_s": MAX_HOMING_S,
+    "max_learning_s": MAX_LEARNING_PHASE_S,
+}
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("env_id", TASKS)
+@pytest.mark.parametrize("case", list(TOO_LONG))
+def test_times_beyond_their_bound_are_refused_when_the_env_is_made(env_id, case):
+    kwargs, message = TOO_LONG[case]
+    with pytest.raises(ValueError, match=message):
+        gym.make(env_id, **kwargs)  # before any reset: no learning phase is started
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("value", [_just_above(MAX_HOMING_S), 1e12])
+def test_homing_refuses_a_min_walk_beyond_its_bound(value):
+    with pytest.raises(ValueError, match=r"min_walk_s must be in \[0, 3600\] seconds"):
+        gym.make("vc_gym/Homing-v0", min_walk_s=value)
+
+
+@pytest.mark.parametrize("env_id", TASKS)
+def test_times_at_their_bound_are_taken(env_id):
+    extra = {"min_walk_s": MAX_HOMING_S} if env_id == "vc_gym/Homing-v0" else {}
+    env = make_task(env_id, place_cache=False, **AT_BOUND, **extra)
+    try:
+        task = env.unwrapped
+        assert task.learn_config.learn_time_s == MAX_LEARN_TIME_S
+        assert task.max_homing_s == task.stop_time_s == MAX_HOMING_S
+        assert task.max_learning_s == MAX_LEARNING_PHASE_S
+        if extra:
+            assert task.stop_action.min_walk_steps == round(MAX_HOMING_S / task.control_dt)
+    finally:
+        env.close()
+
+
+def test_learning_config_bounds_its_times_however_it_is_built():
+    assert LearningConfig(learn_time_s=MAX_LEARN_TIME_S, half_life_s=MAX_HALF_LIFE_S)
+    with pytest.raises(ValueError, match=r"learn_time_s must be in \(0, 60\] seconds"):
+        LearningConfig(learn_time_s=1e12)
+    with pytest.raises(ValueError, match=r"half_life_s must be in \(0, 60\] seconds"):
+        LearningConfig(half_life_s=_just_above(MAX_HALF_LIFE_S))

@@ -25,6 +25,7 @@ def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
         "exhaustion",
         "runs",
         "arguments",
+        "footage",
     }
     assert r["soak"]["steps"] == 40 and r["soak"]["median_steps_per_s"] > 0
     assert "failed 0" in capsys.readouterr().out

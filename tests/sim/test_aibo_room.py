@@ -225,6 +225,7 @@ def test_repeated_make_close_does_not_leak_clients():
         {"illumination": 100.0},
         {"illumination": True},
         {"control_dt": 0.0},
+        {"control_dt": 1e-6},  # no physics step: a time limit would take 10^8 steps
         {"render_mode": "ascii"},
         {"randomize": "yes"},
     ],

@@ -21,8 +21,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "job and settings files (zip bombs, pickled payloads, bit flips, deep nesting, "
             "code named in a file), the same misuse of every registered env (bad actions, "
             "resets, seeds, use after close), faults (killed workers, a lost physics server, "
-            "a rerun of a finished run), commands asked for more than the machine has, then "
-            "a short soak. Prints cases tried, passed and failed (0 expected) and the soak "
+            "a rerun of a finished run), commands asked for more than the machine has, "
+            "footage commands that would replace their input or an earlier output, scale "
+            "past the pixel limit, read truncated frames or get SIGTERM, then a short soak. "
+            "Prints cases tried, passed and failed (0 expected) and the soak "
             "figures; the exit status is 1 if a case failed. The checks of single functions' "
             "arguments are in the unit tests."
         ),
@@ -35,8 +37,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from vc_gym.cli import main
     from vc_gym.experiments.benchmarks.soak import MAX_SOAK_STEPS, MIN_WINDOW, check_soak_args
-    from vc_gym.experiments.check import run_check
+    from vc_gym.experiments.check import all_cases, run_check
     from vc_gym.jobs.output import check_out_file
 
     # the soak's arguments before the cases run; its window is the one run_check uses
@@ -51,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.out:
         check_out_file(args.out)
-    r = run_check(args.soak_steps, args.soak_cycles, progress=not args.json)
+    cases = all_cases(main)  # the footage suite runs its commands in this process
+    r = run_check(args.soak_steps, args.soak_cycles, progress=not args.json, cases=cases)
     if args.out:
         write_json(args.out, r)
     if args.json:

@@ -14,9 +14,10 @@ import math
 from collections.abc import Callable, Iterable
 from dataclasses import fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from vc_gym.cli.arguments import add_json_option, argument_type
+from vc_gym.compass.camera import MAX_HFOV_DEG, MIN_HFOV_DEG
 from vc_gym.compass.config import EXPOSURE_MODES, CompassConfig
 
 if TYPE_CHECKING:  # imported when the command runs: `vc-gym --help` stays light
@@ -25,7 +26,9 @@ if TYPE_CHECKING:  # imported when the command runs: `vc-gym --help` stays light
     from vc_gym.compass import Camera, CompassEstimate, VisualCompass
     from vc_gym.compass.footage import Footage, FootageTrack, Progress, YawTable
 
-__all__ = ["add_parser", "run_learn", "run_track"]
+__all__ = ["TRACK_FILES", "add_parser", "run_learn", "run_track"]
+
+T = TypeVar("T")
 
 #: The folder ``vc-gym compass track`` writes to by default.
 DEFAULT_OUT = "vc_gym_track"
@@ -66,8 +69,11 @@ _YAW_CSV_HELP = (
 
 def _hfov(text: str) -> float:
     v = float(text)
-    if not (math.isfinite(v) and 0 < v < 180):
-        raise ValueError(f"the horizontal field of view must be in (0, 180) degrees, got {text}")
+    if not (math.isfinite(v) and MIN_HFOV_DEG <= v <= MAX_HFOV_DEG):
+        raise ValueError(
+            f"the horizontal field of view must be in [{MIN_HFOV_DEG:g}, {MAX_HFOV_DEG:g}] "
+            f"degrees, got {text}"
+        )
     return v
 
 
@@ -151,7 +157,19 @@ def _add_footage_options(p: argparse.ArgumentParser, what: str, yaws_help: str) 
         type=argument_type(_count(16), "width"),
         metavar="PX",
         help="scale frames to this width first (faster; the field of view is kept; "
-        "default: as stored)",
+        "default: as stored); the scaled frames must stay within 50 megapixels",
+    )
+    p.add_argument(
+        "--skip-bad-frames",
+        action="store_true",
+        help="leave out frames that cannot be read (a truncated or corrupt image, a video "
+        "frame that does not decode) and count them, instead of stopping with an error",
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace output files that exist (without it an existing output is an error "
+        "and is kept)",
     )
 
 
@@ -269,6 +287,29 @@ def _progress(args: argparse.Namespace, desc: str) -> Progress | None:
     return wrap
 
 
+#: Names of the footage functions' arguments as this command's flags (for errors).
+_FLAGS = {
+    "hfov_deg": "--hfov",
+    "focal_px": "--focal",
+    "pitch_deg": "--pitch",
+    "start": "--start",
+    "step": "--step",
+    "max_frames": "--max-frames",
+    "width": "--width",
+    "skip_bad_frames": "--skip-bad-frames",
+}
+
+
+def _named(flag: str, load: Callable[[], T]) -> T:
+    """``load()``, its errors starting with ``flag`` (the option that named the file)."""
+    try:
+        return load()
+    except FileNotFoundError as exc:
+        raise FileNotFoundError(f"{flag} {exc}") from None
+    except ValueError as exc:
+        raise ValueError(f"{flag} {exc}") from None
+
+
 def _footage_and_camera(args: argparse.Namespace) -> tuple[Footage, Camera]:
     from vc_gym.compass.footage import Footage, footage_camera
 
@@ -278,8 +319,10 @@ def _footage_and_camera(args: argparse.Namespace) -> tuple[Footage, Camera]:
         step=args.step,
         max_frames=args.max_frames,
         width=args.width,
+        skip_bad_frames=args.skip_bad_frames,
+        names=_FLAGS,
     )
-    camera = footage_camera(footage, args.hfov, args.focal, args.pitch)
+    camera = footage_camera(footage, args.hfov, args.focal, args.pitch, names=_FLAGS)
     return footage, camera
 
 
@@ -290,12 +333,40 @@ def _yaw_table(args: argparse.Namespace) -> YawTable | None:
         if args.yaw_column is not None:
             raise ValueError("--yaw-column needs --yaws CSV")
         return None
-    return read_yaw_csv(args.yaws, args.yaw_column)
+    return _named("--yaws", lambda: read_yaw_csv(args.yaws, args.yaw_column))
+
+
+def _is_frame_name(path: Path) -> bool:
+    """Whether a footage folder would read a file of this name as a frame."""
+    from vc_gym.compass.footage import IMAGE_SUFFIXES
+
+    return path.suffix.lower() in IMAGE_SUFFIXES and not path.name.startswith(".")
+
+
+def _inputs(args: argparse.Namespace, *more: tuple[str, str | None]) -> list[tuple[str, Any]]:
+    """The files and folders a footage command reads, with the options that named them."""
+    return [("INPUT", args.input), ("--yaws", args.yaws), *more]
 
 
 def _map_path(text: str) -> Path:
+    """``learn``'s ``--map``: the file to write (``.npz`` added when missing, as numpy
+    does), refused at once when empty or naming a folder or a device."""
+    if text == "":
+        raise ValueError("--map: give a file name (e.g. room.npz)")
     path = Path(text)
+    if path.exists() and not path.is_file():
+        kind = "a folder" if path.is_dir() else "not a regular file"
+        raise ValueError(f"--map {text} is {kind}; give a file name (e.g. room.npz)")
     return path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
+
+
+def _skipped_note(footage: Footage) -> str | None:
+    """The line saying which frames ``--skip-bad-frames`` left out, if any."""
+    skipped = footage.skipped
+    if not skipped:
+        return None
+    first = next(iter(skipped.values()))
+    return f"note: skipped {len(skipped)} frames that could not be read (first: {first})"
 
 
 # --------------------------------------------------------------------------- learn
@@ -304,8 +375,12 @@ def run_learn(args: argparse.Namespace) -> int:
     import numpy as np
 
     from vc_gym.compass.footage import calibrate_footage, footage_yaws, learn_footage
-    from vc_gym.jobs.output import check_out_file
+    from vc_gym.jobs.output import check_apart, check_new_files, check_out_file, removed_on_failure
 
+    # outputs first: a refused name costs nothing, and nothing an input holds is replaced
+    map_path = _map_path(args.map)
+    check_apart([("--map", map_path)], _inputs(args), reads=_is_frame_name)
+    check_new_files([("--map", map_path)], args.overwrite)
     config = CompassConfig(
         n_colors=args.n_colors,
         sector_deg=args.sector_deg,
@@ -318,21 +393,24 @@ def run_learn(args: argparse.Namespace) -> int:
         raise ValueError("give --yaws or --turn, not both")
     turn = 360.0 if args.turn is None else args.turn
     yaws = footage_yaws(footage, table, turn)
-    map_path = check_out_file(_map_path(args.map), "--map")
-    vc = learn_footage(
-        footage,
-        camera,
-        yaws,
-        config,
-        rng=np.random.default_rng(args.seed),
-        progress=_progress(args, "learn"),
-    )
-    calibration = calibrate_footage(vc, footage, camera, yaws)
-    written = vc.save(map_path)
+    with removed_on_failure(map_path.parent):
+        check_out_file(map_path, "--map")
+        vc = learn_footage(
+            footage,
+            camera,
+            yaws,
+            config,
+            rng=np.random.default_rng(args.seed),
+            progress=_progress(args, "learn"),
+        )
+        calibration = calibrate_footage(vc, footage, camera, yaws)
+        written = vc.save(map_path)
     source = f"from {args.yaws}" if table is not None else f"{turn:g} deg at a constant rate"
+    learned = len(footage) - len(footage.skipped)
     result = {
         "map": str(written),
-        "frames": len(footage),
+        "frames": learned,
+        "skipped_frames": len(footage.skipped),
         "hfov_deg": camera.hfov_deg,
         "yaws": source,
         "learned_fraction": vc.learned_fraction,
@@ -340,9 +418,12 @@ def run_learn(args: argparse.Namespace) -> int:
         "calibration_frames": calibration.frames if calibration else 0,
     }
     print(
-        f"learned {len(footage)} frames of {footage.path} (hfov {camera.hfov_deg:.1f} deg, "
+        f"learned {learned} frames of {footage.path} (hfov {camera.hfov_deg:.1f} deg, "
         f"yaws {source}); they cover {vc.learned_fraction:.0%} of the circle"
     )
+    note = _skipped_note(footage)
+    if note:
+        print(note)
     if vc.learned_fraction < 1.0:
         print(
             "note: part of the circle was never in view; frames looking there cannot be "
@@ -367,6 +448,10 @@ def run_learn(args: argparse.Namespace) -> int:
 
 
 # --------------------------------------------------------------------------- track
+#: The files ``track`` writes in its ``--out`` folder.
+TRACK_FILES = ("headings.csv", "headings.png", "summary.json")
+
+
 def run_track(args: argparse.Namespace) -> int:
     """``vc-gym compass track``: estimate every frame, write CSV, plot and summary."""
     from vc_gym.compass import VisualCompass
@@ -376,17 +461,35 @@ def run_track(args: argparse.Namespace) -> int:
         track_footage,
         write_track_csv,
     )
-    from vc_gym.jobs.output import check_out_file, new_out_dir, write_json
+    from vc_gym.jobs.output import (
+        check_apart,
+        check_new_files,
+        check_out_file,
+        new_out_dir,
+        removed_on_failure,
+        write_json,
+    )
 
-    compass = VisualCompass.load(args.map)
+    # outputs first: a refused name costs nothing, and nothing an input holds is replaced
+    if args.out == "":
+        raise ValueError("--out: give a folder name")
+    if args.video == "":
+        raise ValueError("--video: give a file name (e.g. track.mp4)")
+    out = Path(args.out)
+    files = [("--out", out / name) for name in TRACK_FILES]
+    video = None if args.video is None else Path(args.video)
+    outputs = [("--out", out), *files, *([("--video", video)] if video else [])]
+    check_apart(outputs, _inputs(args, ("--map", args.map)), reads=_is_frame_name)
+    check_new_files(outputs[1:], args.overwrite)
+    if video is not None:  # an unknown suffix is refused before the work starts
+        _named("--video", lambda: VideoSink(video))
+    compass = _named("--map", lambda: VisualCompass.load(args.map))
     footage, camera = _footage_and_camera(args)
     table = _yaw_table(args)
     truth = footage_yaws(footage, table) if table is not None else None
-    video = None
-    with new_out_dir(args.out) as out:
-        if args.video is not None:
-            video = check_out_file(args.video, "--video")
-            VideoSink(video)  # refuses an unknown suffix before the work starts
+    with removed_on_failure(*([video.parent] if video else [])), new_out_dir(out):
+        if video is not None:
+            check_out_file(video, "--video")
         progress = _progress(args, "track")
         if video is None:
             track = track_footage(compass, footage, camera, truth, progress=progress)
@@ -405,7 +508,10 @@ def run_track(args: argparse.Namespace) -> int:
         _plot(track, out / "headings.png")
         write_json(out / "summary.json", summary)
     print(_summary_line(summary))
-    written = [out / "headings.csv", out / "headings.png", out / "summary.json"]
+    note = _skipped_note(footage)
+    if note:
+        print(note)
+    written = [path for _, path in files]
     if video is not None:
         written.append(video)
     print("wrote " + ", ".join(map(str, written)))

@@ -17,7 +17,15 @@ import numpy as np
 
 from vc_gym.validation import finite_real as _finite
 
-__all__ = ["Camera", "AIBO_HFOV_DEG", "AIBO_RESOLUTION", "MAX_ABS_YAW_DEG"]
+__all__ = [
+    "Camera",
+    "AIBO_HFOV_DEG",
+    "AIBO_RESOLUTION",
+    "MAX_ABS_YAW_DEG",
+    "MAX_HFOV_DEG",
+    "MIN_HFOV_DEG",
+    "check_hfov",
+]
 
 #: Horizontal field of view of the Sony Aibo ERS-7 camera (degrees).
 AIBO_HFOV_DEG = 56.9
@@ -26,6 +34,23 @@ AIBO_HFOV_DEG = 56.9
 MAX_ABS_YAW_DEG = 1e9
 #: (width, height) of the Aibo ERS-7 camera image.
 AIBO_RESOLUTION = (208, 160)
+#: Narrowest horizontal field of view a camera may have (degrees): a long telephoto
+#: lens sees about 2 degrees; below a degree a frame spans a fraction of one sector.
+MIN_HFOV_DEG = 1.0
+#: Widest horizontal field of view a pinhole camera may have (degrees): towards 180 the
+#: focal length goes to zero and the edge columns' directions lose all precision.
+MAX_HFOV_DEG = 179.0
+
+
+def check_hfov(name: str, value: object) -> float:
+    """``value`` as a field of view in degrees within ``[MIN_HFOV_DEG, MAX_HFOV_DEG]``,
+    else a ``ValueError`` naming ``name`` and the range."""
+    hfov = _finite(name, value)
+    if not MIN_HFOV_DEG <= hfov <= MAX_HFOV_DEG:
+        raise ValueError(
+            f"{name} must be in [{MIN_HFOV_DEG:g}, {MAX_HFOV_DEG:g}] degrees, got {value!r}"
+        )
+    return hfov
 
 
 @dataclass(frozen=True)
@@ -35,7 +60,8 @@ class Camera:
     Parameters
     ----------
     hfov_deg : float
-        Horizontal field of view in degrees, ``0 < hfov < 180``. Together with the
+        Horizontal field of view in degrees, in ``[MIN_HFOV_DEG, MAX_HFOV_DEG]``
+        (1 to 179). Together with the
         image width it gives the focal length ``f = (W/2) / tan(hfov/2)`` (pixels;
         square pixels assumed).
     yaw_deg : float
@@ -55,9 +81,7 @@ class Camera:
     principal_point: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        hfov = _finite("hfov_deg", self.hfov_deg)
-        if not 0.0 < hfov < 180.0:
-            raise ValueError(f"hfov_deg must be in (0, 180), got {hfov}")
+        check_hfov("hfov_deg", self.hfov_deg)
         if abs(_finite("yaw_deg", self.yaw_deg)) > MAX_ABS_YAW_DEG:
             # far out, float64 cannot hold a fraction of a degree: sectors would be wrong
             raise ValueError(f"|yaw_deg| must be <= {MAX_ABS_YAW_DEG:g}, got {self.yaw_deg!r}")

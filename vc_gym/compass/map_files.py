@@ -174,6 +174,11 @@ def read_config_and_colors(
             colors = ColorClasses.from_arrays(arrays)
         except ValueError as e:
             raise MapFileError(f"{path}: invalid colour classes ({e})") from None
+        if colors.n_colors != stored.n_colors:
+            raise MapFileError(
+                f"{path}: its config says {stored.n_colors} colour classes, but it holds "
+                f"{colors.n_colors}"
+            )
     return stored, colors
 
 

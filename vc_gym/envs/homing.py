@@ -23,10 +23,12 @@ from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.envs.wrappers.compass_observation import CompassObservation
 from vc_gym.localization import TrackerSpec
 from vc_gym.validation import (
+    MAX_HOMING_S,
     check_action,
     finite_real,
     flag,
     nonnegative_float,
+    nonnegative_float_at_most,
     positive_float,
 )
 
@@ -111,9 +113,7 @@ class HomingFeatures(gym.ObservationWrapper):
     #: Entries the position's spread adds with ``position_std=True``: ``(x, y)``.
     POSITION_STD_WIDTH = 2
 
-    def __init__(
-        self, env: gym.Env, home_offset_m: Any = (0.0, 0.0), position_std: bool = False
-    ):
+    def __init__(self, env: gym.Env, home_offset_m: Any = (0.0, 0.0), position_std: bool = False):
         super().__init__(env)
         self.home_offset_m = home_offset(home_offset_m)
         self.position_std = flag("position_std", position_std)
@@ -168,12 +168,13 @@ class StopAction(gym.Wrapper):
     wrapped task ends the episode (it stops after ``stop_time_s``); the rewards of
     those steps are summed into one. Holding a Gaussian policy's motion outputs near
     zero for 50 steps in a row is all but impossible to learn by chance; one stop
-    decision is easy. Stop requests in the first ``min_walk_s`` of an episode are
-    ignored (the filters are still settling, and an untrained policy would otherwise
-    end most episodes within a step or two), and so are those before the robot has
-    walked ``min_walk_m`` by its own forward commands (default 0): right after a
-    kidnapping 2 m out, one view can look exactly like home (README, *Beyond the
-    paper*), and a policy that trusts it stops where it was put.
+    decision is easy. Stop requests in the first ``min_walk_s`` of an episode (at most
+    an hour, :data:`~vc_gym.validation.MAX_HOMING_S`) are ignored (the filters are
+    still settling, and an untrained policy would otherwise end most episodes within a
+    step or two), and so are those before the robot has walked ``min_walk_m`` by its
+    own forward commands (default 0): right after a kidnapping 2 m out, one view can
+    look exactly like home (README, *Beyond the paper*), and a policy that trusts it
+    stops where it was put.
 
     Only the stop output ends an episode: a walk decision whose command is too small
     to count as moving for the task (``|forward|``, ``|turn|`` ≤ its ``still_threshold``)
@@ -223,7 +224,7 @@ class StopAction(gym.Wrapper):
             )
         self.max_forward = positive_float("max_forward", max_forward)
         self.max_turn_deg_s = positive_float("max_turn_deg_s", max_turn_deg_s)
-        nonnegative_float("min_walk_s", min_walk_s)
+        nonnegative_float_at_most("min_walk_s", min_walk_s, MAX_HOMING_S, "seconds")
         self.min_walk_m = nonnegative_float("min_walk_m", min_walk_m)
         if confirm_stop_m is not None:
             positive_float("confirm_stop_m", confirm_stop_m)
@@ -431,7 +432,7 @@ class HomingEnv(LearnThenHomeEnv):
     tracker : str, dict or callable
         The tracker of the :class:`~vc_gym.envs.CompassObservation` wrapper.
     max_forward, max_turn_deg_s, min_walk_s : float
-        :class:`StopAction` settings.
+        :class:`StopAction` settings (``min_walk_s`` in [0, 3600] seconds).
     confirm_stop_m : float, optional
         :class:`StopAction`'s check of a stop while the robot stands.
     head_scan : bool
@@ -448,7 +449,7 @@ class HomingEnv(LearnThenHomeEnv):
     **task_kwargs
         Arguments of ``vc_gym/LearnThenHome-v0`` (``scene``, ``learn_time_s``,
         ``stop_time_s``, ``success_radius_m``, ``max_homing_s``, ``learning_seed``,
-        ``place_cache``, ``atlas_file``, ...); its learning is scripted.
+        ``place_cache``, ``atlas_file``, ...), with its bounds; its learning is scripted.
     """
 
     def __init__(

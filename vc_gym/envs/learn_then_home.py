@@ -30,12 +30,15 @@ from vc_gym.envs.learning import (
 from vc_gym.envs.place_cache import CachedLearner, PlaceCache, place_key_value
 from vc_gym.poses import compose
 from vc_gym.sim.aibo_room import RESET_OPTIONS, AiboRoomEnv
+from vc_gym.validation import MAX_HOMING_S as LONGEST_HOMING_S
 from vc_gym.validation import (
+    MAX_LEARNING_PHASE_S,
     check_action,
     check_reset_options,
     int_at_least,
     nonnegative_float,
     positive_float,
+    positive_float_at_most,
 )
 
 __all__ = ["EpisodeLimitWarning", "LearnThenHomeEnv", "LEARNING_MODES", "make_task"]
@@ -132,7 +135,12 @@ class LearnThenHomeEnv(gym.Env):
     learn_time_s=5.0, spot_distance_m=1.0, stop_time_s=5.0, success_radius_m=0.3,
     max_homing_s=60.0, ...)`` — see ``__init__``; other keyword arguments (``scene``,
     ``randomize``, ``locomotion``, ``illumination``, ``control_dt``,
-    ``odometry_noise``, ``camera``, ...) go to ``vc_gym/AiboRoom-v0``.
+    ``odometry_noise``, ``camera``, ...) go to ``vc_gym/AiboRoom-v0``. The times are
+    bounded (:mod:`vc_gym.validation`): ``learn_time_s`` to 60 s
+    (``MAX_LEARN_TIME_S``, checked by :class:`~vc_gym.envs.learning.LearningConfig`),
+    ``stop_time_s`` and ``max_homing_s`` to an hour (``MAX_HOMING_S``),
+    ``max_learning_s`` to an hour (``MAX_LEARNING_PHASE_S``); a larger value is a
+    ``ValueError`` naming the argument and its bound, raised before a world is built.
     ``relearn="scene"`` learns once per scene and reuses the atlas in later episodes
     (the paper learned once and kidnapped many times); ``"episode"`` learns anew in
     every reset. ``learner`` is any callable ``learner(room, config) ->
@@ -206,13 +214,17 @@ class LearnThenHomeEnv(gym.Env):
         for name, v in (
             ("learn_time_s", learn_time_s),
             ("spot_distance_m", spot_distance_m),
-            ("stop_time_s", stop_time_s),
             ("success_radius_m", success_radius_m),
-            ("max_homing_s", max_homing_s),
-            ("max_learning_s", max_learning_s),
             ("spot_radius_m", spot_radius_m),
         ):
             positive_float(name, v)
+        # learn_time_s is bounded by LearningConfig, built below before the room
+        for name, v, longest in (
+            ("stop_time_s", stop_time_s, LONGEST_HOMING_S),
+            ("max_homing_s", max_homing_s, LONGEST_HOMING_S),
+            ("max_learning_s", max_learning_s, MAX_LEARNING_PHASE_S),
+        ):
+            positive_float_at_most(name, v, longest, "seconds")
         for name, v in (
             ("kidnap_margin_m", kidnap_margin_m),
             ("still_threshold", still_threshold),
@@ -250,13 +262,6 @@ class LearnThenHomeEnv(gym.Env):
                 "place_cache must be True, False, None, a folder or a PlaceCache, "
                 f"got {place_cache!r}"
             )
-        self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
-        self.render_mode = render_mode
-        self.learning = learning
-        self.relearn = relearn
-        self.learner = learner if learner is not None else ScriptedLearning()
-        self.learning_seed = learning_seed
-        self.atlas_file = atlas_file
         self.learn_config = LearningConfig(
             spot_distance_m=float(spot_distance_m),
             learn_time_s=float(learn_time_s),
@@ -264,6 +269,13 @@ class LearnThenHomeEnv(gym.Env):
             normalise_at=normalise_at,
             around_m=nonnegative_float("around_m", around_m),
         )
+        self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
+        self.render_mode = render_mode
+        self.learning = learning
+        self.relearn = relearn
+        self.learner = learner if learner is not None else ScriptedLearning()
+        self.learning_seed = learning_seed
+        self.atlas_file = atlas_file
         self.stop_time_s = float(stop_time_s)
         self.success_radius_m = float(success_radius_m)
         self.max_homing_s = float(max_homing_s)

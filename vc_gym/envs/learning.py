@@ -29,11 +29,14 @@ from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, Vi
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
 from vc_gym.validation import (
+    MAX_HALF_LIFE_S,
+    MAX_LEARN_TIME_S,
     finite_float,
     flag,
     int_at_least,
     nonnegative_float,
     positive_float,
+    positive_float_at_most,
 )
 
 __all__ = [
@@ -90,7 +93,8 @@ class LearningConfig:
     spot_distance_m : float
         Distance of the four training spots from home (paper: 1 m).
     learn_time_s : float
-        Learning time per direction (paper 4.3: 5 s).
+        Learning time per direction (paper 4.3: 5 s); at most
+        :data:`~vc_gym.validation.MAX_LEARN_TIME_S` (60 s).
     head_scan_deg : tuple of float
         Head pans cycled while learning a direction.
     normalise_at : str
@@ -104,7 +108,8 @@ class LearningConfig:
         Directions at home whose frames normalise the goodness (paper 5.2).
     half_life_s : float
         Mixing half-life of the heading filter that keeps the robot's heading on the
-        home map while it walks between spots (paper 4.2: 0.3 s).
+        home map while it walks between spots (paper 4.2: 0.3 s); at most
+        :data:`~vc_gym.validation.MAX_HALF_LIFE_S` (60 s).
     compass : CompassConfig
         Compass parameters of every map.
     around_m : float
@@ -127,8 +132,9 @@ class LearningConfig:
     around_m: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("spot_distance_m", "learn_time_s", "half_life_s"):
-            positive_float(name, getattr(self, name))
+        positive_float("spot_distance_m", self.spot_distance_m)
+        positive_float_at_most("learn_time_s", self.learn_time_s, MAX_LEARN_TIME_S, "seconds")
+        positive_float_at_most("half_life_s", self.half_life_s, MAX_HALF_LIFE_S, "seconds")
         nonnegative_float("around_m", self.around_m)
         if self.around_m > 0.5 * self.spot_distance_m:
             raise ValueError(

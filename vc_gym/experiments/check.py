@@ -15,7 +15,11 @@ checks that vc_gym answers with a clear error of the promised kind:
   failed) within seconds, a finished run rerun (nothing redone), a lost physics server
   (a ``RuntimeError``; ``reset()`` rebuilds the world);
 - the security suites of :mod:`vc_gym.experiments.check_security`: files that name
-  code, bombs, runs that would destroy runs, command arguments refused before work.
+  code, bombs, runs that would destroy runs, command arguments refused before work;
+- the footage suite of :mod:`vc_gym.experiments.check_footage`: ``vc-gym compass
+  learn/track`` never replacing an input or an earlier output, the pixel limit after
+  scaling, truncated frames, SIGTERM, errors that name the flag typed, and the envs'
+  time limits.
 
 A case fails if anything else happens: another exception, no exception, a hang (each
 case has a time limit), or code from a file running. A short
@@ -49,6 +53,7 @@ from vc_gym.config_files import read_settings
 from vc_gym.errors import MapFileError
 from vc_gym.experiments.benchmarks.soak import soak
 from vc_gym.experiments.check_case import Case, raises
+from vc_gym.experiments.check_footage import footage_cases
 from vc_gym.experiments.check_security import model_with_data, security_cases
 from vc_gym.jobs.backends import LocalBackend
 from vc_gym.jobs.job import Job
@@ -445,13 +450,19 @@ def _env_cases() -> list[Case]:
     return cases
 
 
-def all_cases() -> list[Case]:
-    """Every case of every suite (built on demand: some import heavy modules)."""
+def all_cases(main: Callable[[list[str]], int] | None = None) -> list[Case]:
+    """Every case of every suite (built on demand: some import heavy modules).
+
+    ``main`` (:func:`vc_gym.cli.main`, passed in by the command: this layer does not
+    import the command line) runs the footage suite's commands in this process; without
+    it each runs in a process of its own.
+    """
     return [
         *_hostile_file_cases(),
         *_env_cases(),
         *_fault_cases(),
         *security_cases(),
+        *footage_cases(main),
     ]
 
 

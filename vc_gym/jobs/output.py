@@ -19,7 +19,7 @@ import contextlib
 import json
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +29,8 @@ from vc_gym.persistence import write_atomic
 
 __all__ = [
     "DEFAULT_NAME_MAX",
+    "check_apart",
+    "check_new_files",
     "DEFAULT_PATH_MAX",
     "MAX_JSON_BYTES",
     "OUT_DIR_NAME_RESERVE",
@@ -37,6 +39,7 @@ __all__ = [
     "check_out_file",
     "new_figure",
     "new_out_dir",
+    "removed_on_failure",
     "read_json",
     "save_figure",
     "write_json",
@@ -197,12 +200,20 @@ def new_out_dir(path: str | os.PathLike) -> Iterator[Path]:
     """:func:`check_out_dir` for a run: if the run fails (or is interrupted) before it
     writes anything, the folders this call created are removed again (a refused
     argument leaves nothing)."""
-    made = _created_dirs(Path(path))
-    out = check_out_dir(path)
+    with removed_on_failure(path):
+        yield check_out_dir(path)
+
+
+@contextlib.contextmanager
+def removed_on_failure(*folders: str | os.PathLike) -> Iterator[None]:
+    """Remove again, while empty, the ``folders`` (and their parents) that do not exist
+    when the block starts, if the block fails or is interrupted (Ctrl-C, SIGTERM)."""
+    made = {d for folder in folders for d in _created_dirs(Path(folder))}
+    deepest_first = sorted(made, key=lambda d: len(d.parts), reverse=True)
     try:
-        yield out
+        yield
     except BaseException:
-        _remove_empty(made)
+        _remove_empty(deepest_first, stop_at_first=False)
         raise
 
 
@@ -236,7 +247,7 @@ def check_out_file(path: str | os.PathLike, flag: str = "--out") -> Path:
     extra = TEMP_NAME_EXTRA + len(os.fsencode(out.suffix))
     _check_name_fits(label, out.name, folder, extra)
     if _is_dir(out):
-        raise ValueError(f"{label}: is a folder; give a file name (e.g. {out / 'bench.json'})")
+        raise ValueError(f"{label}: is a folder; give a file name")
     made = _created_dirs(folder)
     try:
         _prepare_dir(label, folder, len(os.fsencode(out.name)) + extra + 1)
@@ -255,13 +266,96 @@ def check_out_file(path: str | os.PathLike, flag: str = "--out") -> Path:
     return out
 
 
-def _remove_empty(made: list[Path]) -> None:
-    """Remove the folders in ``made`` (deepest first) while they are empty."""
+def _same_place(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name the same file or folder: the same inode where both
+    exist (hard links, bind mounts), else the same path once symbolic links, ``..`` and
+    the working folder are resolved."""
+    try:
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+    except OSError:
+        pass
+    return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_apart(
+    outputs: Iterable[tuple[str, str | os.PathLike]],
+    inputs: Iterable[tuple[str, str | os.PathLike | None]],
+    reads: Callable[[Path], bool] | None = None,
+) -> None:
+    """Refuse, before any work, an output that would replace or change an input.
+
+    Parameters
+    ----------
+    outputs : iterable of (flag, path)
+        Every file (and output folder) the command writes, with the option that named
+        it (``("--out", "track/headings.csv")``).
+    inputs : iterable of (flag, path or None)
+        Every file or folder it reads (``None``: not given).
+    reads : callable, optional
+        ``reads(path)``: whether a file of that name inside an input *folder* would be
+        read as part of it (a footage folder reads its images). Such an output is
+        refused too: the next run on that folder would take it for input.
+
+    Raises
+    ------
+    ValueError
+        One line naming both options, e.g. ``--video v.mp4 is INPUT v.mp4: ...``.
+    """
+    given = [(flag, Path(p)) for flag, p in inputs if p is not None and os.fspath(p) != ""]
+    for out_flag, out in ((f, Path(p)) for f, p in outputs):
+        for in_flag, inp in given:
+            if _same_place(out, inp):
+                raise ValueError(
+                    f"{out_flag} {_shown(out)} is {in_flag} {_shown(inp)}: an output never "
+                    "replaces an input; write it elsewhere"
+                )
+            if reads is not None and _is_dir(inp) and _same_place(out.parent, inp) and reads(out):
+                raise ValueError(
+                    f"{out_flag} {_shown(out)} is inside {in_flag} {_shown(inp)}, which would "
+                    "then read it as input; write it elsewhere"
+                )
+
+
+def check_new_files(
+    files: Iterable[tuple[str, str | os.PathLike]], overwrite: bool = False
+) -> None:
+    """Refuse, before any work, to replace a file that exists (``overwrite`` allows it
+    for regular files; a folder, a device or a pipe at that name is always refused).
+
+    Parameters
+    ----------
+    files : iterable of (flag, path)
+        The files a command will write, with the option that named each.
+    overwrite : bool
+        The user's ``--overwrite``.
+
+    Raises
+    ------
+    ValueError
+        Naming the option and the file, and how to go on.
+    """
+    for flag, path in ((f, Path(p)) for f, p in files):
+        if not (path.exists() or path.is_symlink()):
+            continue
+        if not path.is_file():
+            kind = "a folder" if path.is_dir() else "not a regular file"
+            raise ValueError(f"{flag} {_shown(path)} is {kind}; give a file name")
+        if not overwrite:
+            raise ValueError(
+                f"{flag}: {_shown(path)} exists; write elsewhere, or give --overwrite to replace it"
+            )
+
+
+def _remove_empty(made: list[Path], stop_at_first: bool = True) -> None:
+    """Remove the folders in ``made`` (deepest first) while they are empty (all that
+    are empty, with ``stop_at_first=False``: ``made`` then spans several branches)."""
     for folder in made:
         try:
             folder.rmdir()
         except OSError:
-            break
+            if stop_at_first:
+                break
 
 
 def _fsync_dir(folder: Path) -> None:

@@ -21,8 +21,17 @@ from vc_gym.sim.scenes import Scene, build_scene, check_scene_name
 from vc_gym.sim.top_view import TopView
 from vc_gym.validation import check_action, check_reset_options, positive_float
 
-__all__ = ["AiboRoomEnv", "MAX_ILLUMINATION", "ROBOT_CLEARANCE_M", "display_available"]
+__all__ = [
+    "AiboRoomEnv",
+    "MAX_ILLUMINATION",
+    "MIN_CONTROL_DT_S",
+    "ROBOT_CLEARANCE_M",
+    "display_available",
+]
 
+#: Shortest ``control_dt`` (s): one step of the 240 Hz physics. A shorter step would
+#: run no physics at all, and a time limit would take millions of steps to reach.
+MIN_CONTROL_DT_S = 1.0 / 240.0
 #: Brightest ``illumination`` (linear light; 1 is normal, above it frames saturate).
 MAX_ILLUMINATION = 4.0
 #: A placed robot's centre keeps this far inside the room's walls.
@@ -35,13 +44,13 @@ RESET_OPTIONS = ("pose",)
 _ODO_LIMIT = np.array([5.0, 5.0, 720.0], np.float32)
 
 
-
 def display_available() -> bool:
     """Whether a window can be opened here: an X or Wayland display on Linux; always on
     macOS and Windows."""
     if sys.platform in ("darwin", "win32"):
         return True
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
 
 class AiboRoomEnv(gym.Env):
     """A quadruped with the Sony Aibo's head camera exploring a room (PyBullet).
@@ -107,7 +116,8 @@ class AiboRoomEnv(gym.Env):
     * ``illumination``: light level applied to the rendered frames in linear light
       (1 normal, 0.5 the paper's half-illumination test); ``light_direction`` the
       direction of the scene light.
-    * ``control_dt``: seconds of simulated time per step.
+    * ``control_dt``: seconds of simulated time per step, from one physics step
+      (``MIN_CONTROL_DT_S``, 1/240 s) to 1 s.
     * ``odometry_noise``: an ``OdometryNoise`` (scale errors and noise).
     * ``camera``: a ``HeadCameraSpec`` (size and field of view of the head camera).
 
@@ -157,8 +167,11 @@ class AiboRoomEnv(gym.Env):
                 f"illumination must be in (0, {MAX_ILLUMINATION:g}] (1: normal), "
                 f"got {illumination!r}"
             )
-        if not (math.isfinite(control_dt) and 0 < control_dt <= 1.0):
-            raise ValueError(f"control_dt must be in (0, 1] seconds, got {control_dt!r}")
+        if not (math.isfinite(control_dt) and MIN_CONTROL_DT_S <= control_dt <= 1.0):
+            raise ValueError(
+                f"control_dt must be in [1/240, 1] seconds (at least one physics step), "
+                f"got {control_dt!r}"
+            )
         if light_direction is not None:
             light_direction = tuple(float(v) for v in light_direction)
             if len(light_direction) != 3 or not all(math.isfinite(v) for v in light_direction):

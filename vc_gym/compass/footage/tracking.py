@@ -8,7 +8,7 @@ import csv
 import io
 import math
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -17,7 +17,7 @@ import numpy as np
 
 from vc_gym.angles import wrap180
 from vc_gym.compass.calibration import SpreadCalibration
-from vc_gym.compass.camera import Camera
+from vc_gym.compass.camera import MAX_HFOV_DEG, MIN_HFOV_DEG, Camera, check_hfov
 from vc_gym.compass.config import CompassConfig
 from vc_gym.compass.footage.frames import Footage
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass
@@ -26,6 +26,7 @@ from vc_gym.validation import finite_real
 
 __all__ = [
     "CALIBRATION_FRAMES",
+    "CALIBRATION_MAX_BYTES",
     "calibrate_footage",
     "COLOR_FIT_FRAMES",
     "FootageTrack",
@@ -51,24 +52,45 @@ def footage_camera(
     hfov_deg: float | None = None,
     focal_px: float | None = None,
     pitch_deg: float = 0.0,
+    *,
+    names: Mapping[str, str] | None = None,
 ) -> Camera:
     """The camera that filmed ``footage``: from its horizontal field of view, or from
     its focal length in pixels of the frames as stored (``hfov = 2 atan(W / 2f)``).
 
-    Exactly one of ``hfov_deg`` and ``focal_px`` must be given. Scaling the frames
+    Exactly one of ``hfov_deg`` and ``focal_px`` must be given; either way the field of
+    view must lie in ``[MIN_HFOV_DEG, MAX_HFOV_DEG]``. Scaling the frames
     (``Footage(width=...)``) keeps the field of view, so the camera is the same.
+    ``names`` gives the names used in error messages, by argument (a command's flags,
+    e.g. ``{"focal_px": "--focal"}``).
     """
+    label = dict(names or {})
+
+    def name(arg: str) -> str:
+        return label.get(arg, arg)
+
     if (hfov_deg is None) == (focal_px is None):
         raise ValueError(
-            "give the camera's field of view (hfov_deg) or its focal length (focal_px)"
+            f"give the camera's field of view ({name('hfov_deg')}) or its focal length "
+            f"({name('focal_px')})"
         )
+    pitch = finite_real(name("pitch_deg"), pitch_deg)
     if hfov_deg is not None:
-        return Camera(hfov_deg=finite_real("hfov_deg", hfov_deg), pitch_deg=pitch_deg)
-    f = finite_real("focal_px", focal_px)
-    if f <= 0:
-        raise ValueError(f"focal_px must be > 0, got {focal_px!r}")
+        return Camera(hfov_deg=check_hfov(name("hfov_deg"), hfov_deg), pitch_deg=pitch)
+    f = finite_real(name("focal_px"), focal_px)
     width = footage.first_size()[1]
-    return Camera.from_focal(f, width, pitch_deg=pitch_deg)
+    if f <= 0:
+        raise ValueError(f"{name('focal_px')} must be > 0 pixels, got {focal_px!r}")
+    hfov = 2.0 * math.degrees(math.atan((width / 2.0) / f))
+    if not MIN_HFOV_DEG <= hfov <= MAX_HFOV_DEG:
+        lo = (width / 2.0) / math.tan(math.radians(MAX_HFOV_DEG / 2.0))
+        hi = (width / 2.0) / math.tan(math.radians(MIN_HFOV_DEG / 2.0))
+        raise ValueError(
+            f"{name('focal_px')} {focal_px:g}: frames {width} pixels wide would see "
+            f"{hfov:.4g} degrees; the field of view must lie in [{MIN_HFOV_DEG:g}, "
+            f"{MAX_HFOV_DEG:g}] degrees, a focal length in [{lo:.3g}, {hi:.4g}] pixels"
+        )
+    return Camera.from_focal(f, width, pitch_deg=pitch)
 
 
 # ----------------------------------------------------------------------------- learning
@@ -136,6 +158,9 @@ def learn_footage(
 
 #: Most learning frames the spread is calibrated on (spread evenly over the footage).
 CALIBRATION_FRAMES = 72
+#: Most bytes of frames the calibration holds at once: the frames are estimated
+#: together, so large frames mean fewer of them (13 at :data:`MAX_FRAME_PIXELS`).
+CALIBRATION_MAX_BYTES = 2 * 2**30
 
 
 def calibrate_footage(
@@ -144,10 +169,11 @@ def calibrate_footage(
     """Calibrate the spread of a map learned from ``footage`` on its own learning frames.
 
     Up to :data:`CALIBRATION_FRAMES` of the frames :func:`learn_footage` learned (spread
-    evenly) are each estimated against the map without themselves
-    (:meth:`VisualCompass.calibrate` with ``leave_one_out``), which fits the temperature
-    of the spread (eq. 27) so that the truth lies within two spreads about 95 % of the
-    time near the spot.
+    evenly; fewer where they would take more than :data:`CALIBRATION_MAX_BYTES` at the
+    size the compass sees, :attr:`Footage.frame_size`) are each estimated against the
+    map without themselves (:meth:`VisualCompass.calibrate` with ``leave_one_out``),
+    which fits the temperature of the spread (eq. 27) so that the truth lies within two
+    spreads about 95 % of the time near the spot.
 
     Returns
     -------
@@ -156,11 +182,13 @@ def calibrate_footage(
         calibrate on (photos far apart): the map then keeps the paper's spread.
     """
     idx = footage.indices
-    spaced = np.linspace(0, idx.size - 1, min(CALIBRATION_FRAMES, idx.size)).round()
+    height, width = footage.frame_size
+    fits = max(1, CALIBRATION_MAX_BYTES // (3 * height * width))
+    spaced = np.linspace(0, idx.size - 1, min(CALIBRATION_FRAMES, fits, idx.size)).round()
     picks = idx[np.unique(spaced.astype(int))]
     yaws = np.asarray(yaws_deg, dtype=np.float64).tolist()
     yaw_of = dict(zip(idx.tolist(), yaws, strict=True))
-    frames = list(footage.frames(picks))
+    frames = list(footage.frames(picks))  # bad frames left out with skip_bad_frames
     images = [frame for _, frame in frames]
     cameras = [camera.replace(yaw_deg=yaw_of[index]) for index, _ in frames]
     try:
@@ -187,6 +215,9 @@ class FootageTrack:
         placeholder and the frame is left out of the figures.
     true_deg : numpy.ndarray or None
         The known yaw of each frame, if given.
+    skipped : int
+        Frames of the selection left out because they could not be read
+        (``Footage(skip_bad_frames=True)``); they have no row here.
     """
 
     indices: np.ndarray
@@ -195,6 +226,7 @@ class FootageTrack:
     score: np.ndarray
     has_evidence: np.ndarray
     true_deg: np.ndarray | None = None
+    skipped: int = 0
 
     @property
     def error_deg(self) -> np.ndarray | None:
@@ -206,7 +238,8 @@ class FootageTrack:
     def summary(self) -> dict[str, Any]:
         """The figures of the track, as plain numbers (JSON-ready).
 
-        ``frames``, ``frames_with_evidence``, ``median_spread_deg``; with the true yaws
+        ``frames`` (tracked), ``skipped_frames`` (unreadable, left out),
+        ``frames_with_evidence``, ``median_spread_deg``; with the true yaws
         also ``median_abs_error_deg``, ``mean_abs_error_deg``, ``max_abs_error_deg``,
         ``within_5deg`` and ``within_10deg`` (shares) and ``within_2sigma``: the share
         of frames whose true yaw lies within twice the reported spread of the estimate.
@@ -216,6 +249,7 @@ class FootageTrack:
         ev = self.has_evidence
         out: dict[str, Any] = {
             "frames": int(self.indices.size),
+            "skipped_frames": int(self.skipped),
             "frames_with_evidence": int(ev.sum()),
             "median_spread_deg": _median(self.spread_deg[ev]),
         }
@@ -267,6 +301,8 @@ def track_footage(
     Returns
     -------
     FootageTrack
+        One row per frame read; frames skipped as unreadable
+        (``Footage(skip_bad_frames=True)``) have none and are counted in ``skipped``.
     """
     idx = footage.indices
     truth = None
@@ -276,14 +312,24 @@ def track_footage(
             raise ValueError(f"true_deg must be {idx.size} finite numbers, got shape {truth.shape}")
     n = idx.size
     heading, spread, score = np.zeros(n), np.zeros(n), np.zeros(n)
-    evidence = np.zeros(n, dtype=bool)
-    for k, (index, frame) in enumerate(_wrapped(progress, footage.frames(), n)):
+    evidence, read = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    position = {index: k for k, index in enumerate(idx.tolist())}
+    for index, frame in _wrapped(progress, footage.frames(), n):
         est = compass.estimate(frame, camera)
+        k = position[index]
         heading[k], spread[k], score[k] = est.heading_deg, est.spread_deg, est.score
-        evidence[k] = est.has_evidence
+        evidence[k], read[k] = est.has_evidence, True
         if on_frame is not None:
             on_frame(index, frame, est)
-    return FootageTrack(idx, heading, spread, score, evidence, truth)
+    return FootageTrack(
+        idx[read],
+        heading[read],
+        spread[read],
+        score[read],
+        evidence[read],
+        None if truth is None else truth[read],
+        skipped=int(n - read.sum()),
+    )
 
 
 def write_track_csv(path: str | os.PathLike, track: FootageTrack) -> Path:

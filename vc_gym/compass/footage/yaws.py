@@ -80,7 +80,7 @@ def read_yaw_csv(path: str | os.PathLike, column: str | int | None = None) -> Ya
     Raises
     ------
     FileNotFoundError
-        If there is no such file.
+        If there is no such file (a folder or a device there is a ``ValueError``).
     ValueError
         Naming the file and line: larger than :data:`MAX_YAW_CSV_BYTES`, not UTF-8, no
         rows, rows of different lengths, an unknown or ambiguous column, a yaw that is
@@ -88,7 +88,11 @@ def read_yaw_csv(path: str | os.PathLike, column: str | int | None = None) -> Ya
         :data:`~vc_gym.validation.MAX_ABS_DEG`, a file name listed twice.
     """
     path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{path}: a folder, not a CSV file")
     if not path.is_file():
+        if path.exists():
+            raise ValueError(f"{path}: not a regular file")
         raise FileNotFoundError(f"{path}: no such file")
     try:
         with open(path, "rb") as fh:
