@@ -86,7 +86,10 @@ def test_track_writes_csv_plot_summary_and_video(learned_map, footage, tmp_path,
     assert summary["median_abs_error_deg"] == pytest.approx(np.median(errors), abs=2e-3)
     # measured: median 0.3 deg through the video's compression
     assert summary["median_abs_error_deg"] < 1.5
-    assert 0.0 <= summary["within_2sigma"] <= 1.0
+    # the map's spread is calibrated when learned (measured: temperature 2.0, 12 of 12
+    # within 2σ at the 0.5° floor; the paper's spread, temperature 1 and no floor, holds
+    # about a third of the truths)
+    assert summary["within_2sigma"] >= 0.8 and summary["median_spread_deg"] < 5.0, summary
     assert cv2.imread(str(out / "headings.png")) is not None
     cap = cv2.VideoCapture(str(video))
     count = 0

@@ -8,7 +8,6 @@ config does.
 from __future__ import annotations
 
 import json
-import time
 import tracemalloc
 import zipfile
 
@@ -99,10 +98,9 @@ def test_a_map_file_whose_config_claims_gigabytes_is_refused(small_map, tmp_path
         sector_observations=observations,
         frames_learned=np.array(1),
     )
-    start = time.perf_counter()
+    # refused from the config, before any table the config asks for is built
     with pytest.raises(MapFileError, match="hostile.npz: invalid config.*MAX_MAP_BYTES"):
         VisualCompass.load(path)
-    assert time.perf_counter() - start < 5.0
 
 
 @pytest.mark.parametrize(

@@ -9,9 +9,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassAtlas, wrap180
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
 from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.pose_maps import PoseMaps, around_groups
+from vc_gym.exposure import gain_table
 from vc_gym.worlds.room import make_room, render_room_view
 
 WIDTH_M, DEPTH_M = 5.0, 4.0
@@ -163,3 +164,54 @@ def test_heading_at_a_spot_is_the_compass_heading(room, pose_maps):
         terms = pose_maps.frame(render_room_view(room, -1.0, 0.0, Camera(yaw_deg=yaw)), Camera())
         best = float(np.argmax(pose_maps.heading_log_likelihood(terms, 0)))
         assert abs(wrap180(best - yaw)) < 3.0
+
+
+def test_maps_learned_with_exposure_map_are_refused(room, atlas):
+    # exposure="map" brings a frame to each map sector's own light: one set of frame
+    # terms for every pose cannot hold that
+    spot = atlas.compasses[atlas.names.index("spot0")]
+    by_sector = VisualCompass(CompassConfig(exposure="map"), spot.colors)
+    for yaw in range(0, 360, 45):
+        by_sector.learn(render_room_view(room, -1.0, 0.0, Camera(yaw_deg=yaw)), Camera(yaw_deg=yaw))
+    with pytest.raises(ValueError, match='exposure="map"'):
+        PoseMaps.from_atlas(CompassAtlas({"spot0": ((-1.0, 0.0), by_sector)}, home="spot0"))
+
+
+def test_maps_with_other_colour_classes_are_refused(room, atlas, learn_room_turn):
+    """Poses near different spots are compared by their maps' scores: only maps that
+    count the same colour transitions compare."""
+    spot0 = ((-1.0, 0.0), atlas.compasses[atlas.names.index("spot0")])
+    spot1 = ((1.0, 0.0), atlas.compasses[atlas.names.index("spot1")])
+    own = learn_room_turn(room, 1.0, 0.0, yaws=range(0, 360, 45))  # its own colour classes
+    assert not own.shares_colors(spot0[1])
+    with pytest.raises(ValueError, match="colour classes"):
+        PoseMaps.from_atlas(CompassAtlas({"spot0": spot0, "spot1": ((1.0, 0.0), own)}, "spot0"))
+    # the same two spots with shared classes are taken
+    assert len(PoseMaps.from_atlas(CompassAtlas({"spot0": spot0, "spot1": spot1}, "spot0"))) == 2
+
+
+@pytest.mark.parametrize("gain", [2.0, 0.5])
+def test_a_gain_multiplies_the_frames_linear_light(room, pose_maps, gain):
+    """``frame(gain=g)`` scores the frame as the frame with its linear light times
+    ``g`` (:func:`~vc_gym.exposure.gain_table`), as ``VisualCompass.log_likelihood``."""
+    image = render_room_view(room, -0.8, 0.2, Camera(yaw_deg=40.0))
+    with_gain = pose_maps.frame(image, Camera(), gain=gain)
+    lit = pose_maps.frame(np.take(gain_table(gain), image), Camera())
+    np.testing.assert_array_equal(with_gain.per_group, lit.per_group)
+    assert not np.array_equal(with_gain.per_group, pose_maps.frame(image, Camera()).per_group)
+
+
+def test_half_the_light_with_gain_two_finds_the_heading_at_every_spot(room, pose_maps):
+    """At half the light the maps lose the heading; the session's gain of 2 brings the
+    frames back to the learned light and the heading with them."""
+    with_gain, without = [], []
+    for spot, (x, y) in enumerate(SPOTS.values()):
+        for yaw in (20.0, 140.0, 300.0):
+            dark = render_room_view(room, x, y, Camera(yaw_deg=yaw), illumination=0.5)
+            for gain, errors in ((2.0, with_gain), (None, without)):
+                ll = pose_maps.heading_log_likelihood(
+                    pose_maps.frame(dark, Camera(), gain=gain), spot
+                )
+                errors.append(abs(wrap180(float(np.argmax(ll)) - yaw)))
+    assert max(with_gain) <= 2.0, with_gain
+    assert np.mean(np.array(without) > 20.0) >= 0.5, without  # what the gain is for

@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 import traceback
 from pathlib import Path
 
@@ -20,6 +21,8 @@ def main(page: str) -> int:
     for block in code_blocks(Path(page).read_text(encoding="utf-8")):
         where = f"{page}:{block.line} ({block.lang})"
         print(f"--- {where}", flush=True)
+        if os.environ.get("VC_GYM_DOCS_TIMES"):  # where a page's test spends its time
+            print(f"@@@ {where} starts at {time.monotonic():.1f}", file=sys.stderr, flush=True)
         if block.lang == "python":
             try:
                 exec(compile(block.code, where, "exec"), namespace)  # noqa: S102

@@ -81,6 +81,40 @@ def test_modes_choose_the_learning_and_the_policy():
         run.close()
 
 
+def test_the_pose_home_mode_reaches_the_run():
+    """pose-home's policy settings, places and tracker reach the scripted run (built,
+    not run); a policy setting given to the run wins over the mode's."""
+    import inspect
+
+    from vc_gym.agents import ScriptedHomingPolicy
+    from vc_gym.experiments.episode import homing_mode
+    from vc_gym.localization import HomeSwitchTracker
+
+    mode = homing_mode("pose-home")
+    # as HOMING_MODES documents them: check home with a full turn, walk the checked
+    # offset itself, settle 1 s, turn the checks at the robot's own speed
+    assert mode.policy == {
+        "verify_home": True,
+        "verify_gain": 1.0,
+        "verify_turn_deg_s": 90.0,
+        "settle_time_s": 1.0,
+    }
+    defaults = inspect.signature(ScriptedHomingPolicy).parameters
+    # every setting of the mode differs from the policy's default: each is seen to arrive
+    assert all(value != defaults[name].default for name, value in mode.policy.items())
+    for given in ({"max_verifications": 2}, {"settle_time_s": 1.5}):
+        run = make_homing_run(mode="pose-home", policy=given, **SHORT)
+        try:
+            policy = run.act.__self__
+            for name, value in {**mode.policy, **given}.items():
+                assert getattr(policy, name) == value, name
+            learn = run.env.unwrapped.learn_config
+            assert (learn.normalise_at, learn.around_m) == ("start", 0.5)
+            assert isinstance(run.env.get_wrapper_attr("tracker"), HomeSwitchTracker)
+        finally:
+            run.close()
+
+
 def test_a_learned_agent_runs_with_its_stops_checked():
     from vc_gym.agents.learned import PRETRAINED_MODEL
     from vc_gym.envs.homing import StopAction

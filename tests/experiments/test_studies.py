@@ -7,6 +7,7 @@ import json
 import shutil
 
 import cv2
+import numpy as np
 import pytest
 
 from vc_gym.cli import main
@@ -116,14 +117,40 @@ def test_sensors_compares_every_sensor_on_the_same_views(paper_quick):
     # at the spot in full light every image sensor knows its heading
     for name in ("visual_compass_mean_exposure", "image_difference", "feature", "sector_color"):
         assert sim[name]["all_scenes"]["0m_light1"]["median_abs_error_deg"] < 5.0, name
-    if default_real_data_dir() is not None:
-        assert set(r["real"]) == {"rotation_grail", "rotation_parrington"}
-        assert "magnetic" not in r["real"]["rotation_grail"]  # it reads no photo
-        assert r["real"]["rotation_grail"]["feature"]["median_abs_error_deg"] < 5.0
+    if default_real_data_dir() is None:  # the real part: test_sensors_on_the_real_photos
+        assert r["real"] is None and r["real_skipped"]
     cost = json.loads((paper_quick / "sensors" / "run.json").read_text())
     ms = cost["ms_per_frame_median"]["views"]
     assert {f"{n}/localise" for n in SENSORS} <= set(ms)
     assert "magnetometer" in (paper_quick / "report.md").read_text()
+
+
+@pytest.mark.slow
+def test_sensors_on_the_real_photos(paper_quick):
+    """The sensors study's real part: every image sensor on the crops of both rotation
+    sets (learn 9 alternate photos, localise crops of the others)."""
+    from vc_gym.experiments.real_data import default_real_data_dir
+    from vc_gym.experiments.studies.sensors import SENSORS
+
+    if default_real_data_dir() is None:
+        pytest.skip("real photos not found (set VC_GYM_REAL_DATA or place ../shared/data/real)")
+    r = json.loads((paper_quick / "sensors" / "results.json").read_text())
+    assert "real_skipped" not in r
+    assert set(r["real"]) == {"rotation_grail", "rotation_parrington"}
+    for name, per in r["real"].items():
+        assert set(per) == set(SENSORS) - {"magnetic"}, name  # the magnetometer reads no photo
+        for sensor, v in per.items():
+            assert v["n"] == 27, (name, sensor)
+            assert 0.0 <= v["median_abs_error_deg"] <= v["p90_abs_error_deg"] <= 180.0
+            assert 0.0 <= v["within_10deg"] <= 1.0
+    # measured (quick, seed 0), median |error| grail / parrington: feature 0.11° / 0.16°,
+    # image difference 0.12° / 0.15°, the paper's compass 0.83° / 0.95° (81 % / 89 % of
+    # crops within 10°); sector colour 2.8° / 18°
+    for name, per in r["real"].items():
+        assert per["feature"]["median_abs_error_deg"] < 1.0, name
+        assert per["image_difference"]["median_abs_error_deg"] < 1.0, name
+        assert per["visual_compass"]["median_abs_error_deg"] < 3.0, name
+        assert per["visual_compass"]["within_10deg"] >= 0.7, name
 
 
 @pytest.mark.slow
@@ -184,6 +211,27 @@ def test_homing_results_and_video(homing_quick):
     assert [e["seed"] for e in r["per_episode"]] == [1, 2]
     (seed0,) = r["per_seed"]
     assert seed0["episodes"] == 2 and 0.0 <= seed0["success_rate"] <= 1.0
+    # known answers from the episodes: a success is a stop within the success radius,
+    # the mean stop distance theirs
+    episodes = r["per_episode"]
+    radius = seed0["success_radius_m"]
+    assert [e["success"] for e in episodes] == [
+        e["stopped"] and not e["fell"] and e["home_error_m"] <= radius for e in episodes
+    ]
+    assert seed0["success_rate"] == pytest.approx(np.mean([e["success"] for e in episodes]))
+    stops = np.array([e["home_error_m"] for e in episodes])
+    assert seed0["mean_stop_distance_cm"] == pytest.approx(100 * stops.mean(), abs=0.06)
+    # it walks towards home. Measured (quick, seed 0): kidnapped 2.49 m from home (outside
+    # the spots' square, where every spot fits alike: it stops where it was put, the
+    # known weakness of docs/design.md) and 1.38 m (it walks to 0.46 m when its 15 s are
+    # up). A homing that never leaves its kidnapping spot: 2.49 and 1.38.
+    from vc_gym.envs.learning import HOME
+
+    kidnapped = np.array([np.hypot(*np.subtract(e["start_pose"][:2], HOME)) for e in episodes])
+    assert np.all(kidnapped > 1.0), kidnapped
+    near = kidnapped < 2.0  # within 2 m: the spots' signal reaches it
+    assert near.any() and np.all(stops[near] < 0.5 * kidnapped[near]), (stops, kidnapped)
+    assert stops.sum() < 0.9 * kidnapped.sum(), (stops, kidnapped)  # measured 0.76
     assert r["paper"]["mean_stop_offset_cm"] == [-22.0, 12.0]
     field = r["likelihood_field"]
     assert len(field["positions"]) == len(field["goodness"]["east"]) > 4

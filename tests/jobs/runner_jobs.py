@@ -7,8 +7,13 @@ import time
 from pathlib import Path
 
 
-def square(x: float, log: str | None = None, sleep_s: float = 0.0) -> dict:
-    """Figures of ``x``; appends ``x`` to ``log`` when done (to count executions)."""
+def square(
+    x: float, log: str | None = None, sleep_s: float = 0.0, started: str | None = None
+) -> dict:
+    """Figures of ``x``; creates ``started/x`` when it starts (so that a test can wait for
+    busy workers by polling) and appends ``x`` to ``log`` when done (to count executions)."""
+    if started is not None:
+        Path(started, f"{x}").touch()
     time.sleep(sleep_s)
     if log is not None:
         with open(log, "a") as fh:

@@ -21,11 +21,9 @@ HERE = Path(__file__).parent
 JOBS = "runner_jobs"
 
 
-def square_jobs(n, log=None, sleep_s=0.0):
-    return [
-        Job(f"x{i:02d}", f"{JOBS}:square", {"x": i, "log": log, "sleep_s": sleep_s})
-        for i in range(n)
-    ]
+def square_jobs(n, log=None, sleep_s=0.0, started=None):
+    args = {"log": log, "sleep_s": sleep_s, **({"started": started} if started else {})}
+    return [Job(f"x{i:02d}", f"{JOBS}:square", {"x": i, **args}) for i in range(n)]
 
 
 def run_squares(out, workers, n=6, **kwargs):
@@ -99,18 +97,20 @@ def _alive(pid: int) -> bool:
 @pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads /proc")
 def test_workers_of_a_killed_parent_stop_their_jobs(tmp_path):
     log = tmp_path / "done.txt"  # a job that ends writes here
+    started = tmp_path / "started"  # a job that starts writes here
+    started.mkdir()
     script = (
         f"import sys; sys.path.insert(0, {str(HERE)!r}); from test_runner import run_squares; "
-        f"run_squares({str(tmp_path / 'run')!r}, 2, n=2, log={str(log)!r}, sleep_s=120)"
+        f"run_squares({str(tmp_path / 'run')!r}, 2, n=2, log={str(log)!r}, sleep_s=120, "
+        f"started={str(started)!r})"
     )
     proc = subprocess.Popen([sys.executable, "-c", script])
     try:
-        deadline = time.monotonic() + 60  # the pool is up once both workers are busy
-        while time.monotonic() < deadline and not _worker_pids(proc.pid):
-            time.sleep(0.1)
+        deadline = time.monotonic() + 60  # both workers are in their 120 s jobs
+        while time.monotonic() < deadline and len(list(started.iterdir())) < 2:
+            time.sleep(0.05)
         workers = _worker_pids(proc.pid)
         assert len(workers) == 2, "the pool did not start"
-        time.sleep(2.0)  # both workers are now in their 120 s jobs
     finally:
         proc.send_signal(signal.SIGKILL)
         proc.wait()
@@ -163,11 +163,9 @@ def test_a_failing_job_is_retried_once_then_reported(tmp_path):
 
 def test_a_dead_worker_fails_its_job_not_the_run(tmp_path):
     jobs = [Job("dies", f"{JOBS}:die", {}), *square_jobs(4)]
-    t0 = time.monotonic()
-    with LocalBackend(2) as backend:
+    with LocalBackend(2) as backend:  # a hang here is ended by the suite's timeout
         run = ExperimentRun(tmp_path, "toy", backend, {}, progress=False)
         outs = run.run("mixed", jobs)
-    assert time.monotonic() - t0 < 90
     assert outs[0] is None and [o["square"] for o in outs[1:]] == [0, 1, 4, 9]
     (failure,) = run.failures
     assert failure["key"] == "dies" and failure["attempts"] == 2

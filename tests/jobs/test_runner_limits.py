@@ -22,11 +22,9 @@ from vc_gym.jobs.workers import MAX_WORKERS, MAX_WORKERS_PER_CPU, check_workers,
 JOBS = "runner_jobs"
 
 
-def square_jobs(n, log=None, sleep_s=0.0):
-    return [
-        Job(f"x{i:02d}", f"{JOBS}:square", {"x": i, "log": log, "sleep_s": sleep_s})
-        for i in range(n)
-    ]
+def square_jobs(n, log=None, sleep_s=0.0, started=None):
+    args = {"log": log, "sleep_s": sleep_s, **({"started": started} if started else {})}
+    return [Job(f"x{i:02d}", f"{JOBS}:square", {"x": i, **args}) for i in range(n)]
 
 
 def _runs(log: Path) -> int:
@@ -141,36 +139,39 @@ def _alive(pid: int) -> bool:
 def test_ctrl_c_stops_the_workers_at_once(tmp_path):
     """Interrupted, the backend terminates its workers instead of waiting for their
     jobs (here 60 s each) to end."""
-    log = tmp_path / "done.txt"
-    jobs = square_jobs(2, str(log), sleep_s=60.0)
+    log = tmp_path / "done.txt"  # a job that ran its 60 s to the end writes here
+    started = tmp_path / "started"
+    started.mkdir()
+    jobs = square_jobs(2, str(log), sleep_s=60.0, started=str(started))
     pids: list[int] = []
     # Ctrl-C raises KeyboardInterrupt here even if the tests run with SIGINT ignored
     # (started as a background job)
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
-        _interrupt_two_busy_workers(jobs, pids, log)
+        _interrupt_two_busy_workers(jobs, pids, log, started)
     finally:
         signal.signal(signal.SIGINT, previous)
 
 
-def _interrupt_two_busy_workers(jobs, pids, log):
+def _interrupt_two_busy_workers(jobs, pids, log, started):
     with LocalBackend(2) as backend:
 
-        def interrupt() -> None:  # Ctrl-C while both workers are busy
+        def interrupt() -> None:  # Ctrl-C once both workers are in their jobs
+            deadline = time.monotonic() + 60
+            while len(list(started.iterdir())) < 2 and time.monotonic() < deadline:
+                time.sleep(0.02)
             pids.extend(p.pid for p in backend._executor._processes.values())
             os.kill(os.getpid(), signal.SIGINT)  # wakes the main thread's wait, as Ctrl-C
 
-        timer = threading.Timer(8.0, interrupt)
-        t0 = time.monotonic()
+        poller = threading.Thread(target=interrupt, daemon=True)
         with pytest.raises(KeyboardInterrupt):
             with backend:
-                timer.start()
+                poller.start()
                 for _ in backend.run(jobs):
                     pass
-        stopped_after = time.monotonic() - t0
-    timer.cancel()
+        poller.join()
     assert len(pids) == 2
-    assert stopped_after < 30.0  # not the 60 s of the jobs
     assert backend._executor is None
     assert not [pid for pid in pids if _alive(pid)]
-    assert not log.exists()  # no job ran to its end
+    # had the backend waited for its workers, their 60 s jobs would have ended and logged
+    assert not log.exists()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera
+from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.localization import (
     GridTracker,
     HomeSwitchTracker,
@@ -106,3 +106,57 @@ def test_near_tracks_on_the_spots_without_the_turns_around_them(room_atlas, synt
 
 def _parts(atlas):
     return atlas.names, atlas.positions, atlas.compasses
+
+
+#: Home away from the origin and from every spot, so that a distance measured from
+#: anywhere else switches at other places.
+HOME = (0.4, -0.3)
+
+
+def _shifted_home(atlas):
+    """``atlas``'s spots with home at :data:`HOME`."""
+    entries = {n: (tuple(p), c) for n, p, c in zip(*_parts(atlas), strict=True)}
+    return CompassAtlas(entries, home="centre", home_position=HOME)
+
+
+def _answers(atlas, offsets, switch_m):
+    """Which tracker answered (``"far"``/``"near"``) and :attr:`near_home` after each
+    update, with the far tracker placing the robot at ``offsets`` from :data:`HOME`."""
+    far = Scripted([(HOME[0] + dx, HOME[1] + dy) for dx, dy in offsets], goodness=0.0)
+    near = Scripted([(9.0, 9.0)] * len(offsets), goodness=1.0)
+    t = HomeSwitchTracker(far, near, switch_m=switch_m)
+    t.reset(atlas, Camera(), 0.1)
+    image = np.zeros((40, 52, 3), np.uint8)
+    out = []
+    for _ in offsets:
+        state = t.update(image, 0.0, (0.0, 0.0, 0.0))
+        out.append(("near" if state.position == (9.0, 9.0) else "far", t.near_home))
+    return out, t
+
+
+def test_the_switch_is_at_switch_m_from_home_in_any_direction(room_atlas):
+    """Just inside ``switch_m`` (Euclidean, from the atlas' home) the near tracker
+    answers, just outside the far one: along an axis and along a diagonal, where a
+    box (max of |dx|, |dy|) or a diamond (|dx| + |dy|) would switch elsewhere."""
+    inside = [(0.79, 0.0), (0.0, -0.79), (0.6 * 0.79, 0.8 * 0.79), (-0.6 * 0.79, -0.8 * 0.79)]
+    outside = [(0.81, 0.0), (0.0, -0.81), (0.6 * 0.81, 0.8 * 0.81), (-0.6 * 0.81, -0.8 * 0.81)]
+    got, _ = _answers(_shifted_home(room_atlas), inside + outside, switch_m=0.8)
+    assert [who for who, _ in got] == ["near"] * 4 + ["far"] * 4
+
+
+def test_near_home_says_which_tracker_answered_the_last_frame(room_atlas):
+    atlas = _shifted_home(room_atlas)
+    got, t = _answers(atlas, [(2.0, 0.0), (0.1, 0.2), (0.0, -1.5), (0.0, 0.0)], switch_m=0.5)
+    assert got == [("far", False), ("near", True), ("far", False), ("near", True)]
+    t.reset(atlas, Camera(), 0.1)
+    assert t.near_home is False  # a new run starts away from home until a frame says so
+    assert HomeSwitchTracker(switch_m=0.5).near_home is False
+
+
+def test_update_before_reset_is_refused_before_either_tracker_sees_the_frame():
+    far = Scripted([(0.0, 0.0)], goodness=0.0)
+    near = Scripted([(0.0, 0.0)], goodness=1.0)
+    t = HomeSwitchTracker(far, near)
+    with pytest.raises(RuntimeError, match=r"reset\(atlas, camera, dt_s\) before update"):
+        t.update(np.zeros((40, 52, 3), np.uint8), 0.0, (0.0, 0.0, 0.0))
+    assert far.frames == near.frames == 0

@@ -11,7 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from vc_gym.compass import Camera, CompassAtlas, wrap180
+from vc_gym.compass import Camera, CompassAtlas, CompassConfig, VisualCompass, wrap180
+from vc_gym.exposure import SessionLight, rounded_gain
 from vc_gym.localization import PoseTracker, Tracker, make_tracker
 from vc_gym.worlds.room import make_room, render_room_view
 
@@ -174,6 +175,17 @@ def test_either_spot_rule_tracks(room, atlas, rule):
         ({"resolution_m": -0.1}, "resolution_m"),
         ({"resolution_deg": 200.0}, "resolution_deg"),
         ({"spot_rule": "best"}, "spot_rule"),
+        ({"odometry_noise": -0.1}, "odometry_noise"),
+        ({"odometry_noise": 1.5}, "odometry_noise"),  # a fraction of the odometry
+        ({"odometry_noise": float("nan")}, "odometry_noise"),
+        ({"lost_nats": -1.0}, "lost_nats"),
+        ({"lost_nats": float("inf")}, "lost_nats"),
+        ({"lost_nats": "3"}, "lost_nats"),
+        ({"reach_m": 0.0}, "reach_m"),
+        ({"reach_m": float("nan")}, "reach_m"),
+        # the pose maps' lattice is precomputed: refused here, not at the first reset
+        ({"reach_m": 1e9}, "reach_m"),
+        ({"lattice_m": 0.001}, "reach_m / lattice_m"),
     ],
 )
 def test_bad_settings_are_refused(kwargs, match):
@@ -190,3 +202,89 @@ def test_update_before_reset_and_bad_frames_are_refused(room, atlas):
         t.update(np.zeros((160, 208, 3), np.uint8), 0.0, (0, np.nan, 0))
     with pytest.raises(ValueError):
         t.update(np.zeros((160, 208), np.uint8), 0.0, (0, 0, 0))
+
+
+#: The box the particles are kept in with ``margin_m=0.3``: the spots (not the turns
+#: learned 0.5 m around them) grown by 0.3 m.
+BOX_LO, BOX_HI = np.array([-1.3, -1.05]), np.array([1.3, 1.05])
+
+
+def test_particles_moved_out_of_the_room_are_put_on_its_edge(room, atlas):
+    """A 10 m step takes every particle out of the spots' box grown by ``margin_m``:
+    each is clipped back onto the edge it crossed (the robot stays in the room)."""
+    t = PoseTracker(n_particles=64, margin_m=0.3, seed=1)
+    t.reset(atlas, Camera(), 0.1)
+    image = render_room_view(room, 0.0, 0.0, Camera(yaw_deg=90.0))
+    t.update(image, 0.0, (0.0, 0.0, 0.0))
+    t.update(image, 0.0, (10.0, 0.0, 0.0))
+    p = t.particles
+    assert np.all(p[:, :2] >= BOX_LO) and np.all(p[:, :2] <= BOX_HI)
+    # 10 ± 3 m along the particle's own heading (1° of turn noise): it left the box
+    # through the edge its heading points at
+    c, s = np.cos(np.radians(p[:, 2])), np.sin(np.radians(p[:, 2]))
+    for lean, xy, edge in ((c, 0, BOX_HI), (-c, 0, BOX_LO), (s, 1, BOX_HI), (-s, 1, BOX_LO)):
+        np.testing.assert_array_equal(p[lean > 0.5, xy], edge[xy])
+    assert np.all(np.maximum(np.abs(c), np.abs(s)) > 0.5)  # every particle was checked
+
+
+def test_poses_drawn_around_the_spots_stay_in_the_room(room, atlas):
+    """The first frame draws poses around the spots (σ ``reset_spread_m``, here far
+    wider than the room): they are clipped into the box, reaching all four edges."""
+    t = PoseTracker(n_particles=200, margin_m=0.3, reset_spread_m=5.0, seed=1)
+    t.reset(atlas, Camera(), 0.1)
+    t.update(render_room_view(room, 0.0, 0.0, Camera(yaw_deg=90.0)), 0.0, (0.0, 0.0, 0.0))
+    xy = t.particles[:, :2]
+    np.testing.assert_array_equal(xy.min(axis=0), BOX_LO)
+    np.testing.assert_array_equal(xy.max(axis=0), BOX_HI)
+
+
+@pytest.fixture(scope="module")
+def session_atlas(room):
+    """Two of the spots, each with its four turns around it, learned with
+    ``exposure="session"`` (colour classes and reference light from spot0's views)."""
+    config, colors, entries = CompassConfig(exposure="session"), None, {}
+    for i, (x, y) in enumerate(SPOTS[:2]):
+        for side, (dx, dy) in {"": (0.0, 0.0), **AROUND}.items():
+            vc = VisualCompass(config, colors)
+            if colors is None:
+                vc.fit_colors(
+                    [render_room_view(room, x, y, Camera(yaw_deg=a)) for a in range(0, 360, 45)]
+                )
+                colors = vc.colors
+            for a in YAWS if not side else YAWS[1::3]:
+                vc.learn(
+                    render_room_view(room, x + dx, y + dy, Camera(yaw_deg=a)), Camera(yaw_deg=a)
+                )
+            entries[f"spot{i}.{side}" if side else f"spot{i}"] = ((x + dx, y + dy), vc)
+    return CompassAtlas(entries, home="spot0")
+
+
+def test_session_maps_score_every_frame_at_the_sessions_light(room, session_atlas, monkeypatch):
+    """With ``exposure="session"`` maps every frame is scored at one gain: the median
+    of the last ``light_window`` frames' gains (:class:`SessionLight`), not the frame's
+    own. Three frames at full light, then three at a quarter of it: once the window
+    holds only dark frames the gain is 4 times the bright frames'."""
+    t = PoseTracker(n_particles=32, light_window=3)
+    t.reset(session_atlas, Camera(), 0.1)
+    gains = []
+    frame = t.maps.frame
+
+    def scored(image, camera, spots=None, gain=None):
+        gains.append(gain)
+        return frame(image, camera, spots, gain)
+
+    monkeypatch.setattr(t.maps, "frame", scored)
+    frames = [
+        render_room_view(room, -0.8, -0.6, Camera(yaw_deg=yaw), illumination=light)
+        for light in (1.0, 0.25)
+        for yaw in (10.0, 130.0, 250.0)
+    ]
+    for image in frames:
+        t.update(image, 0.0, (0.0, 0.0, 0.0))
+    own = [session_atlas.frame_gain(image, Camera()) for image in frames]
+    session = SessionLight(3)
+    assert gains == [session.update(g) for g in own]
+    assert gains[-1] == pytest.approx(4.0 * gains[2])
+    assert len(t.light) == 3
+    # the frames' own gains differ from the session's: the test tells the two apart
+    assert gains != [rounded_gain(g) for g in own]

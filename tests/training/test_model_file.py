@@ -27,13 +27,14 @@ def _ppo(seed: int = 0):
     return model
 
 
-def test_two_saves_of_a_policy_at_different_times_are_the_same_bytes(tmp_path):
+def test_two_saves_of_a_policy_at_different_times_are_the_same_bytes(tmp_path, monkeypatch):
     model = _ppo()
     save_reproducible_model(model, tmp_path / "a.zip")
     plain = io.BytesIO()
     model.save(plain)
-    time.sleep(1.1)  # a zip's dates have 2 s resolution: cross a second either way
-    model.start_time += 1  # the wall clock moves on
+    now = time.time
+    monkeypatch.setattr(time, "time", lambda: now() + 3601.0)  # an hour and a second later
+    model.start_time += 3601  # as the wall clock moved on
     save_reproducible_model(model, tmp_path / "b.zip")
     assert (tmp_path / "a.zip").read_bytes() == (tmp_path / "b.zip").read_bytes()
     with zipfile.ZipFile(tmp_path / "a.zip") as z:

@@ -30,7 +30,11 @@ from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.scan_geometry import ScanGeometry
 from vc_gym.validation import positive_float
 
-__all__ = ["FrameTerms", "PoseMaps", "around_groups"]
+__all__ = ["MAX_LATTICE_STEPS", "FrameTerms", "PoseMaps", "around_groups"]
+
+#: Most lattice steps from a spot to the edge of its square (``reach_m / lattice_m``):
+#: the lattice is precomputed, ``(2 · 200 + 1)²`` cells a spot.
+MAX_LATTICE_STEPS = 200
 
 
 def around_groups(names: Sequence[str]) -> dict[str, list[str]]:
@@ -114,9 +118,10 @@ class PoseMaps:
             raise ValueError("spots must be a non-empty sequence of ParallaxMap")
         self.lattice_m = positive_float("lattice_m", lattice_m)
         self.reach_m = positive_float("reach_m", reach_m)
-        if self.reach_m / self.lattice_m > 200:
+        if self.reach_m / self.lattice_m > MAX_LATTICE_STEPS:
             raise ValueError(
-                f"reach_m / lattice_m must be at most 200 (the lattice is precomputed), got "
+                f"reach_m / lattice_m must be at most {MAX_LATTICE_STEPS} (the lattice is "
+                "precomputed), got "
                 f"{self.reach_m} / {self.lattice_m}"
             )
         self.maps = tuple(s.centred() for s in spots)

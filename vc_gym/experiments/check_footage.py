@@ -43,8 +43,6 @@ Runner = Callable[[list[str]], tuple[int, str, str]]
 #: The synthetic camera's field of view (degrees) and frame size (width, height).
 HFOV = "60"
 _SIZE = (96, 72)
-#: A refusal must come within this many seconds (before any frame is decoded).
-_REFUSAL_LIMIT_S = 10.0
 
 
 # ------------------------------------------------------------------------ the footage
@@ -119,18 +117,15 @@ def _digest(root: Path) -> dict[str, str]:
 
 
 def _refused(run: Runner, argv: list[str], match: str) -> str:
-    """``vc-gym ARGV`` must exit 2 at once with one line of error holding ``match`` (after
-    argparse's usage lines for a usage error)."""
-    t0 = time.perf_counter()
+    """``vc-gym ARGV`` must exit 2 with one line of error holding ``match`` (after
+    argparse's usage lines for a usage error); ``vc-gym check`` bounds each case's time."""
     code, _, err = run(argv)
-    took = time.perf_counter() - t0
     assert code == 2, f"vc-gym {' '.join(argv[:2])} exited {code}, expected 2: {err[-300:]}"
     # one line of error (a usage error has argparse's usage lines above it)
     last = err.rstrip("\n").split("\n")[-1]
     assert "Traceback" not in err and " error: " in last, f"not one line: {err[-300:]}"
     assert match in last, f"no {match!r} in: {last}"
     assert err.count("\n") == 1 or err.startswith("usage:"), f"more than the error: {err[-300:]}"
-    assert took < _REFUSAL_LIMIT_S, f"refused after {took:.1f} s"
     return err
 
 
@@ -345,9 +340,7 @@ def _message_cases(suite: str, run: Runner) -> list[Case]:
 # ----------------------------------------------------------------------- env limits
 def _env_refuses(env_id: str, **kwargs: float) -> Callable[[Path], None]:
     def run(_: Path) -> None:
-        t0 = time.perf_counter()
         raises(ValueError, "seconds", lambda: gym.make(env_id, **kwargs))
-        assert time.perf_counter() - t0 < _REFUSAL_LIMIT_S, "refused late"
 
     return run
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from vc_gym.angles import wrap360
 from vc_gym.compass import Camera, CompassAtlas
-from vc_gym.compass.pose_maps import FrameTerms, PoseMaps, around_groups
+from vc_gym.compass.pose_maps import MAX_LATTICE_STEPS, FrameTerms, PoseMaps, around_groups
 from vc_gym.exposure import SessionLight
 from vc_gym.filters import ParticleFilter
 from vc_gym.filters.particle_filter import check_particle_count
@@ -198,6 +198,11 @@ class PoseTracker:
         self.spot_rule = spot_rule
         self.lattice_m = positive_float("lattice_m", lattice_m)
         self.reach_m = positive_float("reach_m", reach_m)
+        if self.reach_m / self.lattice_m > MAX_LATTICE_STEPS:  # refused now, not at reset
+            raise ValueError(
+                f"reach_m / lattice_m must be at most {MAX_LATTICE_STEPS} (the pose maps' "
+                f"lattice is precomputed), got {reach_m!r} / {lattice_m!r}"
+            )
         self.light = SessionLight(int_at_least("light_window", light_window, 1))
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
             raise ValueError(f"seed must be an int, got {seed!r}")

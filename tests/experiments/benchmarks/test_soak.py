@@ -3,11 +3,19 @@
 from __future__ import annotations
 
 import json
+from types import SimpleNamespace
 
+import numpy as np
 import pytest
+from gymnasium import Env, spaces
 
 from vc_gym.cli import main
+from vc_gym.experiments.benchmarks import soak as soak_module
 from vc_gym.experiments.benchmarks.soak import rss_bytes, soak
+
+#: Largest growth per make/close cycle (KB) a short soak of a sound env may show: far
+#: below the ~1024 KB that a leak of 1 MB per env reads.
+MAX_CYCLE_GROWTH_KB = 100.0
 
 
 @pytest.mark.slow
@@ -18,14 +26,62 @@ def test_a_short_soak_reports_speed_and_memory(tmp_path, capsys):
     assert r["rss_growth_kb_per_10k_steps"] is not None
     assert r["rss_growth_kb_per_cycle"] is not None and r["rss_after_cycles_mb"] > 0
     assert isinstance(r["cycles_within_target"], bool)
+    # measured (three runs): RSS -1.5 to 2.7 KB per cycle, 0 KB per 10k steps; a leak of
+    # 1 MB per cycle reads 1025-1031 KB per cycle (test_a_leak_of_...)
+    assert abs(r["rss_growth_kb_per_cycle"]) < MAX_CYCLE_GROWTH_KB, r
+    # two windows of 20 steps extrapolated to 10k steps: noisy (measured RSS 0, heap
+    # 906-1969 KB), but a leak of 1 KB per step reads 10,240
+    assert abs(r["rss_growth_kb_per_10k_steps"]) < 8000.0, r
     if r["free_memory_released"]:  # glibc: the C heap is measured too
-        assert r["heap_growth_kb_per_cycle"] is not None
-        assert r["heap_growth_kb_per_10k_steps"] is not None
+        # measured: 0.0 to 0.7 KB per cycle
+        assert abs(r["heap_growth_kb_per_cycle"]) < MAX_CYCLE_GROWTH_KB, r
+        assert abs(r["heap_growth_kb_per_10k_steps"]) < 8000.0, r
     assert rss_bytes() > 0
     out = tmp_path / "soak.json"
     code = main(["soak", "--steps", "40", "--window", "20", "--cycles", "10", "--out", str(out)])
     assert code == 0 and json.loads(out.read_text())["steps"] == 40
     assert "make/close cycles" in capsys.readouterr().out
+
+
+class TinyEnv(Env):
+    """Stands in for the room (fast): the soak's cycles without PyBullet."""
+
+    action_space = spaces.Box(-1.0, 1.0, (5,), np.float32)
+    observation_space = spaces.Box(0.0, 1.0, (1,), np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        return np.zeros(1, np.float32), {}
+
+    def step(self, action):
+        return np.zeros(1, np.float32), 0.0, False, False, {}
+
+
+@pytest.mark.parametrize("leak_mb", [0, 1])
+def test_a_leak_of_one_megabyte_per_env_shows_in_the_cycle_figure(monkeypatch, leak_mb):
+    """Known answer: each env made keeps ``leak_mb`` MB alive (written, so resident);
+    the per-cycle growth reads about that, and without the leak far less. Measured:
+    1024-1028 KB per cycle on this tiny env (0.0 without the leak) and 1025-1031 KB
+    around the real room."""
+    leaked = []
+
+    def make(env_id, **kwargs):
+        assert env_id == soak_module.ENV_ID
+        leaked.append(b"\x01" * (leak_mb * 2**20))
+        return TinyEnv()
+
+    monkeypatch.setattr(soak_module, "gym", SimpleNamespace(make=make))
+    r = soak(steps=20, window=10, cycles=10, seed=0, progress=False)
+    assert len(leaked) == 11  # the long run's env and one per cycle
+    figures = [r["rss_growth_kb_per_cycle"]]
+    if r["free_memory_released"]:
+        figures.append(r["heap_growth_kb_per_cycle"])
+    for kb in figures:
+        if leak_mb:
+            assert 900.0 <= kb <= 1200.0, r
+        else:
+            assert abs(kb) < MAX_CYCLE_GROWTH_KB, r
+    assert r["cycles_within_target"] is (not leak_mb)
 
 
 @pytest.mark.parametrize(
