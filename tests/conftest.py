@@ -41,6 +41,7 @@ SHARED_FIXTURES = frozenset(
 )
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
 def pytest_collection_modifyitems(config, items):
     """Group the tests of one expensive module fixture on one worker (SHARED_FIXTURES)."""
     for item in items:

@@ -12,7 +12,8 @@ import vc_gym  # noqa: F401
 from vc_gym.envs import LearnThenHomeEnv
 from vc_gym.envs.homing import HomingEnv, HomingFeatures, StopAction
 
-FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0}
+#: A short learning phase of one pinned place (learned once per run, from the place cache).
+FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0, "learning_seed": 0}
 
 
 def test_spaces_and_wrapper_chain():
@@ -306,7 +307,9 @@ def test_the_env_class_steps_as_the_task_wrapped_by_hand():
 
     kwargs = {**FAST, "stop_time_s": 1.0, "min_walk_s": 0.5}
     made = gym.make("vc_gym/Homing-v0", previous_action=True, confirm_stop_m=0.25, **kwargs)
-    task = LearnThenHomeEnv(learn_time_s=0.2, max_homing_s=3.0, stop_time_s=1.0, place_cache=False)
+    task = LearnThenHomeEnv(
+        learn_time_s=0.2, max_homing_s=3.0, stop_time_s=1.0, learning_seed=0, place_cache=False
+    )
     by_hand = PreviousAction(
         StopAction(
             HomingFeatures(CompassObservation(task, keep_image=False)),

@@ -10,9 +10,7 @@ import warnings
 import gymnasium as gym
 import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env
 
-import vc_gym
 from vc_gym import CONTROL_DT_S, MAX_HOMING_S, MAX_LEARNING_S, time_limit_steps
 from vc_gym.envs import HomingEnv, LearnThenHomeEnv
 from vc_gym.sim import AiboRoomEnv
@@ -94,25 +92,6 @@ def test_a_limit_beyond_the_registered_horizon_warns():
         assert env.unwrapped.max_episode_steps == 30
         env.close()
         LearnThenHomeEnv(max_homing_s=120.0, **kwargs).close()  # no gym.make, no TimeLimit
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("env_id", sorted(vc_gym.ENV_SPECS))
-def test_both_checkers_pass_on_the_unwrapped_env(env_id):
-    sb3_checker = pytest.importorskip("stable_baselines3.common.env_checker")
-    kwargs = {} if env_id == "vc_gym/AiboRoom-v0" else {"learn_time_s": 0.2}
-    env = gym.make(env_id, camera=SMALL, **kwargs)
-    with warnings.catch_warnings(record=True) as record:
-        warnings.simplefilter("always")
-        check_env(env.unwrapped)
-        sb3_checker.check_env(env.unwrapped, warn=True)
-    env.close()
-    problems = [
-        str(w.message)
-        for w in record
-        if "channel" not in str(w.message) and "pkg_resources" not in str(w.message)
-    ]
-    assert not problems, problems
 
 
 def test_homing_is_one_class():

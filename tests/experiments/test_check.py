@@ -7,11 +7,14 @@ import json
 import pytest
 
 from vc_gym.cli import main
+from vc_gym.experiments import check
 from vc_gym.experiments.check import Case, all_cases, run_check
 
 
 @pytest.mark.slow
-def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
+def test_every_case_passes_and_the_soak_reports(tmp_path, capsys, monkeypatch):
+    # the footage suite's cases run one by one in tests/experiments/test_check_footage.py
+    monkeypatch.setattr(check, "footage_cases", lambda main=None: [])
     out = tmp_path / "check.json"
     code = main(["check", "--soak-steps", "40", "--soak-cycles", "10", "--out", str(out)])
     r = json.loads(out.read_text())
@@ -25,7 +28,6 @@ def test_every_case_passes_and_the_soak_reports(tmp_path, capsys):
         "exhaustion",
         "runs",
         "arguments",
-        "footage",
     }
     assert r["soak"]["steps"] == 40 and r["soak"]["median_steps_per_s"] > 0
     assert "failed 0" in capsys.readouterr().out
@@ -39,6 +41,13 @@ def test_the_env_suite_covers_every_registered_env():
         mine = [n for n in names if n.startswith(env_id + ":")]
         assert len(mine) == 13 and mine[0].endswith("step before reset")
         assert mine[-1].endswith("after close")
+
+
+def test_the_footage_suite_is_part_of_the_check():
+    from vc_gym.cli import main as cli_main
+
+    names = {c.suite for c in all_cases(cli_main)}
+    assert "footage" in names
 
 
 def test_a_case_that_escapes_is_reported():

@@ -37,8 +37,8 @@ WRAPPED = {"vc_gym/Homing-v0"}
 
 #: Per-env keyword arguments that keep the tests fast (a short scripted learning phase).
 FAST = {
-    "vc_gym/LearnThenHome-v0": {"learn_time_s": 0.2},
-    "vc_gym/Homing-v0": {"learn_time_s": 0.2},
+    "vc_gym/LearnThenHome-v0": {"learn_time_s": 0.2, "learning_seed": 0},
+    "vc_gym/Homing-v0": {"learn_time_s": 0.2, "learning_seed": 0},
 }
 
 
