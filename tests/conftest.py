@@ -20,36 +20,6 @@ from vc_gym.worlds.panorama import Panorama, render_view
 from vc_gym.worlds.panorama_painters import make_panorama
 from vc_gym.worlds.room import Room, make_room, render_room_view
 
-#: Module fixtures that run an experiment, a training or a learning phase. Every test of
-#: a module that uses one runs on one xdist worker (``--dist loadgroup``), so that each is
-#: built once per run rather than once per worker that draws one of its tests.
-SHARED_FIXTURES = frozenset(
-    {
-        "paper_quick",  # tests/experiments/test_studies.py
-        "homing_quick",
-        "trained",  # tests/training/test_training.py
-        "run",  # tests/training/test_training_safety.py
-        "place",  # tests/training/test_home_offset.py
-        "quick",  # tests/experiments/studies/test_calibration.py
-        "shared",  # tests/envs/test_atlas_file.py
-        "learned",  # tests/envs/test_place_cache.py
-        "task",  # tests/envs/test_env_inputs.py
-        "homing",
-        "atlas",  # tests/localization/test_pose_tracker.py
-        "kidnapped_walk",
-    }
-)
-
-
-@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
-def pytest_collection_modifyitems(config, items):
-    """Group the tests of one expensive module fixture on one worker (SHARED_FIXTURES)."""
-    for item in items:
-        names = sorted(SHARED_FIXTURES & set(getattr(item, "fixturenames", ())))
-        if names and item.module is not None:
-            item.add_marker(pytest.mark.xdist_group(f"{item.module.__name__}:{names[0]}"))
-
-
 settings.register_profile("default", max_examples=50, derandomize=True, deadline=None)
 settings.register_profile("thorough", max_examples=500, derandomize=False, deadline=None)
 settings.load_profile(os.environ.get("VC_GYM_HYPOTHESIS", "default"))

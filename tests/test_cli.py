@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import subprocess
@@ -134,6 +135,15 @@ def no_work(monkeypatch):
     def started(*args, **kwargs):
         raise AssertionError("work started before the arguments were checked")
 
+    # every module that binds these names at import is imported first: one imported while
+    # they are replaced would keep the replacement after the test
+    import pkgutil
+
+    import vc_gym
+
+    for info in pkgutil.walk_packages(vc_gym.__path__, "vc_gym."):
+        if not info.name.endswith("__main__") and not info.name.startswith("vc_gym.baselines"):
+            importlib.import_module(info.name)
     for target in WORK:
         monkeypatch.setattr(target, started)
 
@@ -309,7 +319,9 @@ def test_ctrl_c_stops_a_running_experiment_and_its_workers(tmp_path):
     out = tmp_path / "run"
     with open(err_path, "w") as err:
         proc = subprocess.Popen(
-            ["vc-gym", "experiment", "homing", "--quick", "--workers", "2", "--out", str(out)],
+            # far more episodes than it runs before the Ctrl-C: still busy when it comes
+            ["vc-gym", "experiment", "homing", "--quick", "--episodes", "200", "--workers", "2",
+             "--out", str(out)],  # fmt: skip
             stdout=subprocess.DEVNULL,
             stderr=err,
             start_new_session=True,
@@ -318,9 +330,9 @@ def test_ctrl_c_stops_a_running_experiment_and_its_workers(tmp_path):
             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
         )
     try:
-        deadline = time.monotonic() + 120  # the workers are busy learning
+        deadline = time.monotonic() + 120  # both workers are busy with episodes
         while time.monotonic() < deadline and not (
-            "homing: learn" in err_path.read_text() and len(_pool_workers(proc.pid)) == 2
+            "homing: episodes" in err_path.read_text() and len(_pool_workers(proc.pid)) == 2
         ):
             time.sleep(0.05)
         os.killpg(proc.pid, signal.SIGINT)
