@@ -351,57 +351,39 @@ def footage_cases(main: Callable[[list[str]], int] | None = None) -> list[Case]:
     """
     suite = "footage"
     run = in_subprocess if main is None else in_process(main)
-    return [
-        Case(
-            suite,
+    refused = [  # (case, the command, what its one line of error says)
+        (
             "track --video INPUT: refused, the video unchanged",
-            _unchanged(run, _video_over_input, "--video TMP/other.mp4 is INPUT TMP/other.mp4"),
+            _video_over_input,
+            "--video TMP/other.mp4 is INPUT TMP/other.mp4",
         ),
-        Case(
-            suite,
-            "track --video a symbolic link to INPUT: refused",
-            _unchanged(run, _video_link_to_input, "is INPUT"),
-        ),
-        Case(
-            suite,
-            "track --video a hard link to INPUT: refused",
-            _unchanged(run, _video_hard_link_to_input, "is INPUT"),
-        ),
-        Case(
-            suite,
+        ("track --video a symbolic link to INPUT: refused", _video_link_to_input, "is INPUT"),
+        ("track --video a hard link to INPUT: refused", _video_hard_link_to_input, "is INPUT"),
+        (
             "track FRAMES --out FRAMES: refused, the footage folder unchanged",
-            _unchanged(run, _out_is_the_frames, "--out TMP/frames is INPUT TMP/frames"),
+            _out_is_the_frames,
+            "--out TMP/frames is INPUT TMP/frames",
         ),
-        Case(
-            suite,
+        (
             "track --yaws OUT/headings.csv: refused",
-            _unchanged(run, _out_holds_the_yaws, "is --yaws TMP/tr/headings.csv"),
+            _out_holds_the_yaws,
+            "is --yaws TMP/tr/headings.csv",
         ),
-        Case(
-            suite,
-            "track --out an earlier track: kept; --overwrite replaces",
-            functools.partial(_existing_track_kept, run),
-        ),
-        Case(
-            suite,
-            "learn --map an existing file: kept; --overwrite replaces",
-            functools.partial(_existing_map_kept, run),
-        ),
-        Case(
-            suite,
+        (
             "learn --width 16384 on 96x72 frames: refused before decoding",
-            _unchanged(run, _width_past_the_limit, "--width 16384: frames of 96x72 pixels"),
+            _width_past_the_limit,
+            "--width 16384: frames of 96x72 pixels",
         ),
-        Case(
-            suite,
-            "a truncated JPEG: refused by name; --skip-bad-frames counts it",
-            functools.partial(_truncated_jpeg, run),
-        ),
-        Case(
-            suite,
-            "SIGTERM while tracking: exit 143, nothing half-written",
-            functools.partial(_sigterm_while_tracking, run),
-        ),
+    ]
+    flows = [  # (case, a run of several commands)
+        ("track --out an earlier track: kept; --overwrite replaces", _existing_track_kept),
+        ("learn --map an existing file: kept; --overwrite replaces", _existing_map_kept),
+        ("a truncated JPEG: refused by name; --skip-bad-frames counts it", _truncated_jpeg),
+        ("SIGTERM while tracking: exit 143, nothing half-written", _sigterm_while_tracking),
+    ]
+    return [
+        *(Case(suite, name, _unchanged(run, make, match)) for name, make, match in refused),
+        *(Case(suite, name, functools.partial(flow, run)) for name, flow in flows),
         *_message_cases(suite, run),
         *(
             Case(
