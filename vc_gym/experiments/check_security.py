@@ -372,21 +372,25 @@ def _hear_ctrl_c() -> None:
 
 
 def _interrupted(tmp: Path) -> None:
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "vc_gym.cli", "soak", "--steps", "100000", "--cycles", "10"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        stdin=subprocess.DEVNULL,
-        text=True,
-        preexec_fn=_hear_ctrl_c,
-    )
-    time.sleep(8.0)
+    err_path = tmp / "stderr.txt"
+    with open(err_path, "w") as err_file:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "vc_gym.cli", "soak", "--steps", "100000", "--cycles", "10"],
+            stdout=subprocess.DEVNULL,
+            stderr=err_file,
+            stdin=subprocess.DEVNULL,
+            preexec_fn=_hear_ctrl_c,
+        )
+    deadline = time.monotonic() + COMMAND_LIMIT_S
+    while "soak: steps" not in err_path.read_text() and time.monotonic() < deadline:
+        time.sleep(0.05)  # Ctrl-C once the soak is stepping
     proc.send_signal(signal.SIGINT)
     try:
-        _, err = proc.communicate(timeout=30)
+        proc.wait(timeout=30)
     except subprocess.TimeoutExpired:
         proc.kill()
         raise AssertionError("vc-gym soak did not stop within 30 s of Ctrl-C") from None
+    err = err_path.read_text()
     assert proc.returncode == 130, f"exit {proc.returncode} after Ctrl-C, expected 130"
     assert "Traceback" not in err and "interrupted" in err, f"after Ctrl-C: {err[-300:]}"
 
