@@ -307,6 +307,7 @@ def _pool_workers(parent: int) -> list[int]:
     return found
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not os.path.isfile("/proc/self/stat"), reason="reads /proc")
 def test_ctrl_c_stops_a_running_experiment_and_its_workers(tmp_path):
     """SIGINT to the whole process group, as Ctrl-C in a terminal sends it: one line,

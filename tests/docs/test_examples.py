@@ -14,7 +14,7 @@ SMALL = ["--learn-time", "0.2", "--max-homing", "4"]
 #: script -> (small arguments, a line its output must hold, marks)
 RUNS = {
     "compass_in_a_room.py": (["--views", "6", "--out", "errors.png"], "wrote errors.png", []),
-    "own_tracker.py": (["--episodes", "1", *SMALL], "mean stop", []),
+    "own_tracker.py": (["--episodes", "1", *SMALL], "mean stop", [pytest.mark.slow]),
     "train_ppo.py": (
         ["--timesteps", "64", "--n-envs", "2", "--episodes", "1", *SMALL, "--out", "m.zip"],
         "model saved to m.zip",

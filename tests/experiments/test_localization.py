@@ -39,6 +39,7 @@ def test_bad_inputs_are_clear_errors(call):
         call()
 
 
+@pytest.mark.slow
 def test_the_experiment_end_to_end(tmp_path, capsys):
     assert main(["experiment", "localization", "--quick", "--out", str(tmp_path)]) == 0
     r = json.loads((tmp_path / "results.json").read_text())

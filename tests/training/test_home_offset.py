@@ -83,6 +83,7 @@ def test_the_offset_is_the_trackers_error_at_the_stops(make):
     assert d["per_place_m"] == [[0.12, -0.07]]
 
 
+@pytest.mark.slow
 def test_places_are_pooled_and_reported_one_by_one(make):
     envs = [make(BiasedOracle((0.1, 0.0))), make(BiasedOracle((0.3, -0.2)))]
     measured = measure_home_offset(envs, 3, seed=0, expert=StopAtOnce())
