@@ -351,12 +351,12 @@ def _inputs(args: argparse.Namespace, *more: tuple[str, str | None]) -> list[tup
 def _map_path(text: str) -> Path:
     """``learn``'s ``--map``: the file to write (``.npz`` added when missing, as numpy
     does), refused at once when empty or naming a folder or a device."""
+    from vc_gym.jobs.output import check_new_files
+
     if text == "":
         raise ValueError("--map: give a file name (e.g. room.npz)")
     path = Path(text)
-    if path.exists() and not path.is_file():
-        kind = "a folder" if path.is_dir() else "not a regular file"
-        raise ValueError(f"--map {text} is {kind}; give a file name (e.g. room.npz)")
+    check_new_files([("--map", path)], overwrite=True)  # a folder or device as typed
     return path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
 
 
@@ -478,9 +478,10 @@ def run_track(args: argparse.Namespace) -> int:
     out = Path(args.out)
     files = [("--out", out / name) for name in TRACK_FILES]
     video = None if args.video is None else Path(args.video)
-    outputs = [("--out", out), *files, *([("--video", video)] if video else [])]
+    written_files = [*files, *([("--video", video)] if video else [])]
+    outputs = [("--out", out), *written_files]
     check_apart(outputs, _inputs(args, ("--map", args.map)), reads=_is_frame_name)
-    check_new_files(outputs[1:], args.overwrite)
+    check_new_files(written_files, args.overwrite)
     if video is not None:  # an unknown suffix is refused before the work starts
         _named("--video", lambda: VideoSink(video))
     compass = _named("--map", lambda: VisualCompass.load(args.map))

@@ -106,11 +106,16 @@ class Camera:
         principal_point: tuple[float, float] | None = None,
     ) -> Camera:
         """Build a camera from a focal length in pixels and the image width."""
+        return cls(cls.hfov_of_focal(focal_px, width), yaw_deg, pitch_deg, principal_point)
+
+    @staticmethod
+    def hfov_of_focal(focal_px: float, width: int) -> float:
+        """The horizontal field of view (degrees) of a focal length in pixels for an image
+        ``width`` pixels wide: ``2 atan(W / 2f)`` (not checked against the lens range)."""
         f = _finite("focal_px", focal_px)
         if f <= 0 or int(width) < 1:
             raise ValueError(f"focal_px and width must be positive, got {focal_px}, {width}")
-        hfov = 2.0 * math.degrees(math.atan((int(width) / 2.0) / f))
-        return cls(hfov, yaw_deg, pitch_deg, principal_point)
+        return 2.0 * math.degrees(math.atan((int(width) / 2.0) / f))
 
     def replace(self, **changes: object) -> Camera:
         """Return a copy with some fields changed (e.g. ``cam.replace(yaw_deg=90)``)."""

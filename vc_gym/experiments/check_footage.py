@@ -32,7 +32,7 @@ import numpy as np
 from vc_gym.compass import Camera
 from vc_gym.compass.footage import VideoSink
 from vc_gym.experiments.check_case import Case, raises
-from vc_gym.worlds.panorama import render_view
+from vc_gym.worlds.panorama import Panorama, render_view
 from vc_gym.worlds.panorama_painters import make_panorama
 
 __all__ = ["Runner", "footage_cases", "footage_fixture", "in_process", "in_subprocess"]
@@ -46,8 +46,14 @@ _SIZE = (96, 72)
 
 
 # ------------------------------------------------------------------------ the footage
+@functools.cache
+def _panorama() -> Panorama:
+    """The synthetic room every case films (painted once per process)."""
+    return make_panorama(np.random.default_rng(11), width=1200, height=300, kind="room")
+
+
 def _views(yaws: np.ndarray, size: tuple[int, int] = _SIZE) -> list[np.ndarray]:
-    pano = make_panorama(np.random.default_rng(11), width=1200, height=300, kind="room")
+    pano = _panorama()
     return [render_view(pano, Camera(hfov_deg=float(HFOV), yaw_deg=y), *size) for y in yaws]
 
 

@@ -81,10 +81,10 @@ def footage_camera(
     width = footage.first_size()[1]
     if f <= 0:
         raise ValueError(f"{name('focal_px')} must be > 0 pixels, got {focal_px!r}")
-    hfov = 2.0 * math.degrees(math.atan((width / 2.0) / f))
+    hfov = Camera.hfov_of_focal(f, width)
     if not MIN_HFOV_DEG <= hfov <= MAX_HFOV_DEG:
-        lo = (width / 2.0) / math.tan(math.radians(MAX_HFOV_DEG / 2.0))
-        hi = (width / 2.0) / math.tan(math.radians(MIN_HFOV_DEG / 2.0))
+        lo = Camera(hfov_deg=MAX_HFOV_DEG).focal_px(width)
+        hi = Camera(hfov_deg=MIN_HFOV_DEG).focal_px(width)
         raise ValueError(
             f"{name('focal_px')} {focal_px:g}: frames {width} pixels wide would see "
             f"{hfov:.4g} degrees; the field of view must lie in [{MIN_HFOV_DEG:g}, "
