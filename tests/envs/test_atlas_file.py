@@ -59,6 +59,24 @@ def test_episodes_do_not_depend_on_who_learned_the_atlas(shared):
     np.testing.assert_array_equal(images2, images)
 
 
+def test_a_missing_file_is_written_from_the_place_cache(shared, tmp_path):
+    _, (poses, images), learned = shared  # its place went to the session's place cache too
+    path = tmp_path / "copy.npz"
+    env = gym.make("vc_gym/LearnThenHome-v0", atlas_file=path, learning_seed=3, **FAST)
+    poses2, images2 = episode(env, seed=5)
+    assert env.unwrapped.cached_learner.learned is False  # loaded from the cache
+    assert env.unwrapped.learner.learned and path.is_file()  # and written to the file
+    env.close()
+    np.testing.assert_array_equal(poses2, poses)
+    np.testing.assert_array_equal(images2, images)
+    off = gym.make(
+        "vc_gym/LearnThenHome-v0", atlas_file=tmp_path / "own.npz", learning_seed=3,
+        place_cache=False, **FAST,
+    )  # fmt: skip
+    assert off.unwrapped.place_cache is None
+    off.close()
+
+
 @pytest.mark.parametrize(
     "change", [{"learn_time_s": 0.3}, {"learning_seed": 4}, {"scene": "office"}]
 )

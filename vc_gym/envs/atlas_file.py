@@ -88,7 +88,9 @@ class AtlasFile:
             raise ValueError(f"atlas_file {str(self.path)!r}: its folder does not exist")
         self.learner = learner
         self.spec = json.loads(json.dumps(dict(spec), sort_keys=True))
-        self.learned = False  # whether the last call learned (True) or loaded (False)
+        #: Whether the last call wrote the file (learned, or from a place cache: True) or
+        #: loaded it (False).
+        self.learned = False
 
     def __repr__(self) -> str:
         return f"AtlasFile({str(self.path)!r}, {self.learner!r})"
@@ -108,12 +110,16 @@ class AtlasFile:
         name = hashlib.sha256(str(self.path.resolve()).encode()).hexdigest()[:32]
         return default_cache_dir() / "locks" / f"{name}.npz.lock"
 
-    def __call__(self, room, config: LearningConfig) -> LearningResult:
+    def __call__(
+        self, room, config: LearningConfig, learner: Learner | None = None
+    ) -> LearningResult:
+        """Load the file, or run ``learner`` (default: the file's own learner, e.g. a
+        place cache's learner standing in for it) and write the file."""
         with file_lock(self.lock_path):
             if self.path.exists():
                 self.learned = False
                 return self._load()
-            result = self.learner(room, config)
+            result = (learner or self.learner)(room, config)
             if not isinstance(result, LearningResult):
                 return result  # the task env reports a learner that returns the wrong type
             result.atlas.save(

@@ -159,14 +159,15 @@ class LearnThenHomeEnv(gym.Env):
     env to need it learns and writes it, every later one (other workers too, under a
     lock) loads it instead of learning; a file learned with other settings is refused.
     With an ``atlas_file``, episodes do not depend on whether this env learned or
-    loaded the atlas. Without one, the scripted learning phase is kept in the place
+    loaded the atlas. The scripted learning phase is kept in the place
     cache (``place_cache=True``, default; :mod:`vc_gym.envs.place_cache`): a place is
     learned once per set of settings and learning seed, by the first env that needs it
     (a progress bar on stderr), and loaded by every later env, in this run or another,
     with bit-identical episodes. ``place_cache`` may also be a folder or a
     :class:`~vc_gym.envs.place_cache.PlaceCache`; ``False`` (or ``None``) learns in
     every env. Only the default learner is cached, and only when the learning seed is
-    known (``learning_seed``, or a seeded first reset).
+    known (``learning_seed``, or a seeded first reset). A missing ``atlas_file`` is
+    written from the cache when the cache has the place.
 
     ## Info
 
@@ -289,6 +290,9 @@ class LearnThenHomeEnv(gym.Env):
         self.success_bonus = float(success_bonus)
         self.closeness_bonus = float(closeness_bonus)
         self.fall_penalty = float(fall_penalty)
+        #: The learner that runs the learning phase when neither the atlas file nor the
+        #: place cache has the place.
+        self.place_learner = self.learner
         if atlas_file is not None:
             spec = {
                 "scene": self.room.scene_name,
@@ -298,13 +302,13 @@ class LearnThenHomeEnv(gym.Env):
                 "room": {k: repr(v) for k, v in sorted(room_kwargs.items())},
             }
             self.learner = AtlasFile(atlas_file, self.learner, spec)
-        #: The place cache the scripted learning phase uses (``None``: off).
+        #: The place cache the scripted learning phase uses (``None``: off); with an
+        #: ``atlas_file``, a missing file is filled from it.
         self.place_cache = (
             cache
             if cache is not None
-            and atlas_file is None
             and learning == "scripted"
-            and type(self.learner) is ScriptedLearning
+            and type(self.place_learner) is ScriptedLearning
             else None
         )
         #: The place cache's learner of the last learning phase (``learned``: whether it
@@ -387,12 +391,12 @@ class LearnThenHomeEnv(gym.Env):
         try:
             key = {
                 "scene": self.room.scene_name,
-                "learner": repr(self.learner),
+                "learner": repr(self.place_learner),
                 "learning": self.learn_config.to_key(),
                 "learning_seed": int(learn_seed),
                 "room": place_key_value(room),
             }
-            return self.place_cache.learner(self.learner, key)
+            return self.place_cache.learner(self.place_learner, key)
         except TypeError:
             return None
 
@@ -487,9 +491,11 @@ class LearnThenHomeEnv(gym.Env):
         if self.atlas is None or self.relearn == "episode" or key != self._atlas_key:
             self.atlas = self.learning_result = None
             self.cached_learner = self._cached_learner(learn_seed)
-            learner = self.cached_learner or self.learner
             try:
-                result = learner(self.room, self.learn_config)
+                if isinstance(self.learner, AtlasFile):  # a missing file comes from the cache
+                    result = self.learner(self.room, self.learn_config, self.cached_learner)
+                else:
+                    result = (self.cached_learner or self.learner)(self.room, self.learn_config)
             except RobotFell as exc:
                 raise RuntimeError(
                     "the robot fell during the scripted learning phase; use "

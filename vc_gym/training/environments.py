@@ -47,7 +47,8 @@ def training_env(config: TrainConfig, out_dir: str | os.PathLike) -> gym.Env:
 def learn_places(config: TrainConfig, out_dir: str | os.PathLike) -> int:
     """Run the learning phase of each of ``config``'s places once, into its atlas file in
     the run folder ``out_dir`` (kept if it is there already and was learned the same
-    way). Returns how many places were learned now."""
+    way; a place in the place cache is copied from there). Returns how many atlas files
+    were written now."""
     learned = 0
     for seed, f in run_places(config, out_dir):
         env = place_env(config, seed, f)
