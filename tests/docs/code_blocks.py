@@ -5,7 +5,10 @@ Python ones in one namespace (a later block may use what an earlier one made). A
 block preceded by the line ``<!-- test-with: COMMAND -->`` runs ``COMMAND`` instead: a
 small stand-in for a command that takes minutes or installs the package; a block
 preceded by ``<!-- test-setup: COMMAND -->`` runs ``COMMAND`` (bash) first, to make
-the input files a reader would bring (e.g. a video). A page with
+the input files a reader would bring (e.g. a video). A bash block preceded by
+``<!-- test: parse -->`` is not run: each of its ``vc-gym`` command lines is parsed by
+vc-gym's own parser (parse_commands.py), so every flag it shows is checked in one
+process. A page with
 the line ``<!-- test: slow -->`` is left out of ``pytest -m "not slow"``. Other blocks
 (``text``, ``json``, ``yaml``) show output or file contents and are not run.
 """
@@ -20,6 +23,7 @@ ROOT = Path(__file__).resolve().parents[2]
 RUN_LANGS = ("python", "bash")
 _FENCE = re.compile(r"^(?P<indent> *)```(?P<lang>[\w-]*)[^\n]*$")
 _DIRECTIVE = re.compile(r"^\s*<!--\s*test-(?P<kind>with|setup):\s*(?P<cmd>.+?)\s*-->\s*$")
+_PARSE = re.compile(r"^\s*<!--\s*test:\s*parse\s*-->\s*$")
 SLOW_MARK = "<!-- test: slow -->"
 
 
@@ -60,6 +64,10 @@ def code_blocks(text: str) -> list[Block]:
             directives = _directives(lines, start)
             if directives and lang != "bash":
                 raise ValueError(f"test directive before a {lang} block at line {start + 1}")
+            if "parse" in directives:  # the block's commands parsed, in this process
+                if set(directives) != {"parse"}:
+                    raise ValueError(f"test: parse takes no other directive (line {start + 1})")
+                lang, body = "python", f"import parse_commands\nparse_commands.check({body!r})\n"
             if "with" in directives:
                 body = directives["with"] + "\n"
             if "setup" in directives:
@@ -70,11 +78,17 @@ def code_blocks(text: str) -> list[Block]:
 
 
 def _directives(lines: list[str], fence: int) -> dict[str, str]:
-    """The ``test-with``/``test-setup`` comments on the lines right above a fence."""
+    """The ``test-with``/``test-setup``/``test: parse`` comments on the lines right
+    above a fence."""
     found: dict[str, str] = {}
     i = fence - 1
-    while i >= 0 and (m := _DIRECTIVE.match(lines[i])):
-        found[m["kind"]] = m["cmd"]
+    while i >= 0:
+        if m := _DIRECTIVE.match(lines[i]):
+            found[m["kind"]] = m["cmd"]
+        elif _PARSE.match(lines[i]):
+            found["parse"] = ""
+        else:
+            break
         i -= 1
     return found
 

@@ -57,6 +57,23 @@ def test_blocks_are_parsed_with_their_stand_ins() -> None:
         code_blocks("```python\nx = 1\n")
 
 
+def test_a_parsed_block_checks_every_flag_it_shows() -> None:
+    from parse_commands import check
+
+    blocks = code_blocks("<!-- test: parse -->\n```bash\nvc-gym demo --seed 3  # one\n```\n")
+    assert blocks[0].lang == "python" and "parse_commands" in blocks[0].code
+    shown = "vc-gym experiment homing --out r --seeds 0,1 \\\n    --mode check-home\nvc-gym demo\n"
+    assert check(shown) == 2
+    with pytest.raises(AssertionError, match="--no-such-flag"):
+        check("vc-gym demo --no-such-flag 1\n")
+    with pytest.raises(AssertionError, match="invalid choice"):
+        check("vc-gym experiment nosuch --out r\n")
+    with pytest.raises(AssertionError, match="not a vc-gym command"):
+        check("python -c pass\n")
+    with pytest.raises(ValueError, match="no other directive"):
+        code_blocks("<!-- test-setup: touch x -->\n<!-- test: parse -->\n```bash\nvc-gym\n```\n")
+
+
 def test_a_failing_block_fails_the_page(tmp_path: Path) -> None:
     page = tmp_path / "page.md"
     page.write_text("```python\nx = 1\n```\n```bash\ntest -f missing\n```\n")

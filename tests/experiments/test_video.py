@@ -18,7 +18,7 @@ from vc_gym.experiments.video import (
     write_episode_video,
 )
 
-SHORT = {"learn_time_s": 0.3, "max_homing_s": 3.0}
+SHORT = {"learn_time_s": 0.2, "max_homing_s": 3.0}
 POSE = {"pose": (1.5, -0.8, 30.0)}  # kidnapped well away from home
 
 

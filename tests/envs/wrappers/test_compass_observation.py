@@ -188,6 +188,7 @@ def test_a_tracker_from_outside_the_package_runs_a_whole_episode():
         learn_time_s=0.2,
         max_homing_s=4.0,
         camera=HeadCameraSpec(52, 40, 56.9),
+        learning_seed=0,
     )
     w = CompassObservation(task, keep_image=False, tracker=DeadReckoning)
     policy = ScriptedHomingPolicy.for_env(w, settle_time_s=0.0)
