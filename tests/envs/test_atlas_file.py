@@ -9,8 +9,9 @@ import pytest
 import vc_gym  # noqa: F401
 from vc_gym.envs.atlas_file import AtlasFile
 from vc_gym.errors import MapFileError
+from vc_gym.sim import HeadCameraSpec
 
-FAST = {"learn_time_s": 0.2}
+FAST = {"learn_time_s": 0.2, "camera": HeadCameraSpec(52, 40, 56.9)}
 STEPS = [np.array([0.6, 0.0, 0.3, 0.5, 0.0], np.float32)] * 5
 
 

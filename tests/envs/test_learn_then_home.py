@@ -13,15 +13,19 @@ from vc_gym.agents.scripted import ScriptedHomingPolicy
 from vc_gym.compass import CompassAtlas
 from vc_gym.envs import CompassObservation
 from vc_gym.envs.learning import LearningResult
+from vc_gym.sim import HeadCameraSpec
 
 STILL = np.zeros(5, np.float32)
+SMALL_CAMERA = HeadCameraSpec(52, 40, 56.9)  # the suite's test camera
 WALK = np.array([0.5, 0, 0, 0, 0], np.float32)  # 0.25 m/s straight ahead
 
 
 @pytest.fixture(scope="module")
 def env():
-    # the place of every fast env of the suite learned at this size (one learning a run)
-    e = gym.make("vc_gym/LearnThenHome-v0", learn_time_s=0.2, learning_seed=0)
+    # the place most fast envs of the suite share (learned once a run)
+    e = gym.make(
+        "vc_gym/LearnThenHome-v0", learn_time_s=0.2, learning_seed=0, camera=SMALL_CAMERA
+    )
     yield e
     e.close()
 

@@ -79,17 +79,39 @@ def test_commit_outside_git(tmp_path: Path) -> None:
     assert source_commit(tmp_path) == "not a git checkout"
 
 
-def test_experiment_writes_its_page(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+@pytest.mark.slow
+def test_experiment_writes_its_figures_plot_and_page(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     page = tmp_path / "docs" / "results" / "synthetic-compass.md"
-    argv = ["experiment", "synthetic-compass", "--out", str(tmp_path / "run"), "--page", str(page)]
+    out = tmp_path / "run"
+    argv = ["experiment", "synthetic-compass", "--out", str(out), "--seed", "3"]
+    argv += ["--page", str(page)]
     assert main(argv) == 0
+    summary = json.loads((out / "results.json").read_text())
+    assert set(summary["results"]) == {
+        f"{scene}/exposure={e}"
+        for scene in ("room", "outdoor")
+        for e in ("none", "mean", "map", "session")
+    }
+    normal = summary["results"]["room/exposure=none"]["illumination_1.0"]
+    assert normal["median_error_deg"] < 5.0
+    # every correction keeps the heading at half light, where the paper's compass loses it
+    for e in ("mean", "map", "session"):
+        assert summary["results"][f"room/exposure={e}"]["illumination_0.5"]["within_5deg"] >= 0.85
+    session = summary["results"]["room/exposure=session"]
+    assert session["illumination_1.0"]["session_gain"] == 1.0
+    assert session["illumination_0.5"]["session_gain"] == 2.0
+    assert session["illumination_1.0"]["median_error_deg"] == normal["median_error_deg"]
+    assert "duration_s" not in summary  # results.json holds figures only
+    png = (out / "synthetic_compass.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+    # the page: the command as typed, the figures exactly as printed, a copy of the run
     text = page.read_text()
-    assert f"`vc-gym experiment synthetic-compass --out {tmp_path / 'run'} --page {page}`" in text
-    printed = capsys.readouterr().out
-    first_figure = printed.splitlines()[0]
-    assert first_figure in text  # the figures exactly as printed
-    results = json.loads((tmp_path / "run" / "results.json").read_text())
-    assert json.loads((page.with_suffix("") / "results.json").read_text()) == results
+    assert f"`vc-gym experiment synthetic-compass --out {out} --seed 3 --page {page}`" in text
+    first_figure = capsys.readouterr().out.splitlines()[0]
+    assert first_figure in text
+    assert json.loads((page.with_suffix("") / "results.json").read_text()) == summary
     assert any(p.suffix == ".png" for p in page.with_suffix("").iterdir())
 
 

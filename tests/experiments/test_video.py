@@ -49,6 +49,7 @@ def near(rgb, target, tol=60) -> bool:
     return bool(np.all(np.abs(np.asarray(rgb, int) - np.asarray(target, int)) <= tol))
 
 
+@pytest.mark.slow  # an episode on a learned place
 def test_video_has_a_frame_per_step_and_shows_true_and_estimated_pose(run, tmp_path):
     path = tmp_path / "out" / "episode.mp4"  # the folder is created
     video = EpisodeVideo(path, run.env)
@@ -83,6 +84,7 @@ def test_video_has_a_frame_per_step_and_shows_true_and_estimated_pose(run, tmp_p
     assert not near(frame[v, u], TRUE_RGB)  # the estimate is not where the body is drawn
 
 
+@pytest.mark.slow  # an episode on a learned place
 def test_the_video_does_not_change_the_episode(run, tmp_path):
     plain = run_episode(run, seed=7)
     steps: list[EpisodeStep] = []
@@ -97,6 +99,7 @@ def test_the_video_does_not_change_the_episode(run, tmp_path):
     assert steps[-1].info["stopped"] == plain.stopped
 
 
+@pytest.mark.slow  # an episode on a learned place
 def test_frames_rendered_from_the_env_equal_the_observed_ones(run, tmp_path):
     """Without the frame in the observation (a learned agent's env), the video
     renders the head camera again: the same pixels."""
@@ -117,6 +120,7 @@ def test_frames_rendered_from_the_env_equal_the_observed_ones(run, tmp_path):
     assert list(tmp_path.iterdir()) == []  # aborted videos leave nothing
 
 
+@pytest.mark.slow  # an episode on a learned place
 def test_a_failed_episode_writes_no_file(run, tmp_path):
     path = tmp_path / "ep.mp4"
     path.write_bytes(b"old")
@@ -135,6 +139,7 @@ def test_a_failed_episode_writes_no_file(run, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["ep.mp4"]
 
 
+@pytest.mark.slow  # an episode on a learned place
 def test_an_unavailable_codec_is_a_clear_error(run, tmp_path, monkeypatch):
     class ClosedWriter:
         def __init__(self, *args):
@@ -152,6 +157,7 @@ def test_an_unavailable_codec_is_a_clear_error(run, tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow  # an episode on a learned place
 def test_bad_arguments(run, tmp_path):
     with pytest.raises(ValueError, match="fps"):
         EpisodeVideo(tmp_path / "ep.mp4", run.env, fps=0.0)

@@ -9,10 +9,17 @@ import pytest
 import vc_gym  # noqa: F401
 from vc_gym.envs.homing import HomingFeatures
 from vc_gym.localization import TrackerState
+from vc_gym.sim import HeadCameraSpec
 from vc_gym.training.feature_expert import HomingFeatureExpert
 from vc_gym.training.home_offset import MIN_STOPS, centre_home_offset, measure_home_offset
 
-FAST = {"learn_time_s": 0.2, "max_homing_s": 3.0, "stop_time_s": 0.3, "min_walk_s": 0.0}
+FAST = {
+    "learn_time_s": 0.2,
+    "max_homing_s": 3.0,
+    "stop_time_s": 0.3,
+    "min_walk_s": 0.0,
+    "camera": HeadCameraSpec(52, 40, 56.9),  # the tracker reads the true pose
+}
 BIAS = (0.12, -0.07)
 
 
