@@ -1,0 +1,155 @@
+"""Colour-class changes along the horizon band of a frame, kept at their columns: bearings.
+
+The compass of the paper counts the colour-class transitions of a frame per 4.5° sector
+(section 3.4, eq. 11-12) and so forgets where in the sector each one was. A pixel of the
+208-pixel head camera spans 0.27°; an edge between two coloured surfaces (a door frame,
+a poster's side, a wall corner) sits at one column. This module keeps those columns.
+
+In a band of rows just above the horizon every column gets the colour class most of its
+band pixels have; runs of one class at least ``min_run_px`` wide are *solid*, and every
+change from one solid run to the next (across at most ``max_gap_px`` columns of other
+classes) is an event: the pair of classes ``(left, right)`` in the image and the column
+of the change, found to a fraction of a pixel from the share of band rows that still
+show the left class in the columns around it (a slanted or blurred edge gives a
+fractional column). With the camera model, the column is a bearing relative to the
+camera's yaw: :class:`FrameBearings`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vc_gym.compass.camera import Camera
+from vc_gym.compass.colors import ColorClasses
+from vc_gym.images import check_image
+from vc_gym.validation import int_at_least
+
+__all__ = ["DEFAULT_BAND_DEG", "FrameBearings", "frame_bearings"]
+
+#: Elevations (degrees above the horizon) of the band whose columns are read: the walls
+#: just above eye height, where a wall of 0.5 m or more fills every column to 3 m away.
+DEFAULT_BAND_DEG = (0.5, 4.0)
+
+
+@dataclass(frozen=True)
+class FrameBearings:
+    """The colour-class changes of one frame along its horizon band.
+
+    Attributes
+    ----------
+    offsets_deg : numpy.ndarray
+        ``(K,)`` direction of each change relative to the camera's yaw, degrees, left
+        positive (:meth:`Camera.column_offsets_deg`).
+    left, right : numpy.ndarray
+        ``(K,)`` colour classes on the image's left and right of the change.
+    n_colors : int
+        Number of colour classes (a pair's code is ``left * n_colors + right``).
+    hfov_deg : float
+        The camera's horizontal field of view (what a frame could see).
+    """
+
+    offsets_deg: np.ndarray
+    left: np.ndarray
+    right: np.ndarray
+    n_colors: int
+    hfov_deg: float
+
+    def __len__(self) -> int:
+        return int(self.offsets_deg.size)
+
+    @property
+    def pairs(self) -> np.ndarray:
+        """``(K,)`` integer code of each change's ``(left, right)`` class pair."""
+        return self.left.astype(np.int64) * self.n_colors + self.right.astype(np.int64)
+
+
+def _band_rows(camera: Camera, width: int, height: int, band_deg: tuple[float, float]) -> slice:
+    lo, hi = (float(v) for v in band_deg)
+    if not (math.isfinite(lo) and math.isfinite(hi) and -80.0 < lo < hi < 80.0):
+        raise ValueError(f"band_deg must be two elevations lo < hi in (-80, 80), got {band_deg}")
+    f = camera.focal_px(width)
+    horizon = camera.horizon_row(width, height)
+    top = horizon - f * math.tan(math.radians(hi))
+    bottom = horizon - f * math.tan(math.radians(lo))
+    r0, r1 = max(0, math.ceil(top)), min(height, math.floor(bottom) + 1)
+    return slice(r0, max(r0, r1))
+
+
+def frame_bearings(
+    image: np.ndarray,
+    camera: Camera,
+    colors: ColorClasses,
+    band_deg: tuple[float, float] = DEFAULT_BAND_DEG,
+    min_run_px: int = 3,
+    max_gap_px: int = 3,
+) -> FrameBearings:
+    """The colour-class changes of ``image`` along its horizon band, as bearings.
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        ``(H, W, 3)`` uint8 RGB frame.
+    camera : Camera
+        The camera that took it (field of view, pitch, principal point); its yaw is not
+        used: the offsets are relative to it.
+    colors : ColorClasses
+        The colour classes of the map (eq. 7's ``g``).
+    band_deg : tuple of float
+        Elevations above the horizon, degrees, of the band's lower and upper edge
+        (clipped to the image).
+    min_run_px : int
+        Narrowest run of one class that counts as a surface.
+    max_gap_px : int
+        Widest stretch of other classes between two surfaces whose change is still
+        one event (a blurred or anti-aliased edge); wider, no event.
+
+    Returns
+    -------
+    FrameBearings
+        Empty when the band lies outside the image.
+    """
+    img = check_image(image, "image")
+    int_at_least("min_run_px", min_run_px, 1)
+    int_at_least("max_gap_px", max_gap_px, 0)
+    height, width = img.shape[:2]
+    n = colors.n_colors
+    rows = _band_rows(camera, width, height, band_deg)
+    empty = np.zeros(0, np.int64)
+    if rows.stop - rows.start < 1:
+        return FrameBearings(np.zeros(0), empty, empty, n, camera.hfov_deg)
+    classes = colors.classify(img[rows]).astype(np.int64)  # (R, W)
+    counts = np.zeros((n, width), np.float64)
+    np.add.at(counts, (classes, np.broadcast_to(np.arange(width), classes.shape)), 1.0)
+    share = counts / classes.shape[0]
+    column_class = np.argmax(share, axis=0)
+    # runs of one class: [start, end) column ranges
+    cut = np.flatnonzero(column_class[1:] != column_class[:-1]) + 1
+    starts = np.concatenate(([0], cut))
+    ends = np.concatenate((cut, [width]))
+    solid = np.flatnonzero(ends - starts >= min_run_px)
+    positions, lefts, rights = [], [], []
+    for a, b in zip(solid[:-1], solid[1:], strict=True):
+        left, right = column_class[starts[a]], column_class[starts[b]]
+        gap = starts[b] - ends[a]
+        if left == right or gap > max_gap_px:
+            continue
+        # from the last column of the left surface to the first of the right one: the
+        # share of band rows still showing the left class, of those showing either
+        u = np.arange(ends[a] - 1, starts[b] + 1)
+        both = share[left, u] + share[right, u]
+        p_left = np.where(both > 0, share[left, u] / np.maximum(both, 1e-12), 0.5)
+        edge = u[0] + float(np.sum(p_left))  # in pixel-edge coordinates
+        positions.append(edge - 0.5)  # pixel centres lie at integer columns
+        lefts.append(left)
+        rights.append(right)
+    offsets = camera.column_offsets_deg(np.asarray(positions, np.float64), width, height)
+    return FrameBearings(
+        np.asarray(offsets, np.float64).reshape(-1),
+        np.asarray(lefts, np.int64),
+        np.asarray(rights, np.int64),
+        n,
+        float(camera.hfov_deg),
+    )

@@ -1,0 +1,138 @@
+"""The landmarks' bearings as a pose sensor: where each one should appear, against where
+the frame shows a change of its colour pair.
+
+A candidate pose ``(x, y, θ)`` with the head panned by ``pan`` looks along
+``ψ = θ + pan``; a landmark at ``L`` then appears at the offset
+``atan2(L - (x, y)) - ψ`` from the optical axis, if that lies inside the field of view.
+Each change the frame shows (:func:`~vc_gym.compass.bearings.frame_bearings`) is explained
+by the landmark of its colour pair whose predicted offset is nearest, with a Gaussian
+error of the sub-pixel column's noise and the landmark's own position uncertainty seen
+from that distance; or by nothing (a door, a person, a change no turn learned) with the
+probability ``outlier``, so that one stray change cannot wipe out the right pose. The
+log-likelihood of a pose is the sum over the frame's changes (the outlier-robust
+product of the paper's sensor model, eq. 16, with bearings instead of sector
+histograms). It is a :class:`~vc_gym.filters.sensor_protocol.PoseSensor`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, frame_bearings
+from vc_gym.compass.camera import Camera
+from vc_gym.compass.colors import ColorClasses
+from vc_gym.localization.landmarks import LandmarkMap
+from vc_gym.validation import positive_float
+
+__all__ = ["BearingSensor"]
+
+
+class BearingSensor:
+    """Pose log-likelihood of a frame from the bearings of learned landmarks.
+
+    Parameters
+    ----------
+    landmarks : LandmarkMap
+        The learned landmarks.
+    colors : ColorClasses
+        The colour classes the landmarks were learned with.
+    camera : Camera, optional
+        The camera that takes the frames (default: the Aibo head camera).
+    noise_deg : float
+        σ of an observed change's bearing (sub-pixel column, edge blur), degrees.
+    outlier : float
+        Probability density floor, relative to a perfect match, for a change that no
+        landmark explains, in ``(0, 1)``.
+    band_deg : tuple of float
+        The horizon band the changes are read in (see ``frame_bearings``).
+    """
+
+    def __init__(
+        self,
+        landmarks: LandmarkMap,
+        colors: ColorClasses,
+        camera: Camera | None = None,
+        noise_deg: float = 0.5,
+        outlier: float = 0.05,
+        band_deg: tuple[float, float] = DEFAULT_BAND_DEG,
+    ):
+        if not isinstance(landmarks, LandmarkMap):
+            raise ValueError(f"landmarks must be a LandmarkMap, got {type(landmarks).__name__}")
+        if landmarks.n_colors != colors.n_colors:
+            raise ValueError(
+                f"the landmarks use {landmarks.n_colors} colour classes, the colours "
+                f"{colors.n_colors}"
+            )
+        self.landmarks = landmarks
+        self.colors = colors
+        self.camera = Camera() if camera is None else camera
+        self.noise_deg = positive_float("noise_deg", noise_deg)
+        outlier = positive_float("outlier", outlier)
+        if outlier >= 1.0:
+            raise ValueError(f"outlier must be in (0, 1), got {outlier}")
+        self.outlier = outlier
+        self.band_deg = band_deg
+
+    def bearings(self, image: np.ndarray) -> FrameBearings:
+        """The changes of one frame (what :meth:`pose_log_likelihood` reads)."""
+        return frame_bearings(image, self.camera, self.colors, self.band_deg)
+
+    def pose_log_likelihood(
+        self,
+        observation: np.ndarray | FrameBearings,
+        poses: np.ndarray,
+        head_pan_deg: float = 0.0,
+    ) -> np.ndarray:
+        """``log p(frame | pose)`` up to a constant, for every row of ``poses``.
+
+        Parameters
+        ----------
+        observation : numpy.ndarray or FrameBearings
+            The camera image, or its :meth:`bearings` already computed.
+        poses : numpy.ndarray
+            ``(N, 3)`` body poses ``x`` (m), ``y`` (m), ``θ`` (deg).
+        head_pan_deg : float
+            Head pan when the frame was taken (left positive).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(N,)`` log-likelihoods; 0 for every pose when the frame shows no change.
+        """
+        p = np.asarray(poses, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
+        if not np.all(np.isfinite(p)):
+            raise ValueError("poses must be finite")
+        if not math.isfinite(head_pan_deg):
+            raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
+        obs = observation if isinstance(observation, FrameBearings) else self.bearings(observation)
+        total = np.zeros(len(p))
+        if len(obs) == 0:
+            return total
+        lm = self.landmarks
+        half = math.radians(obs.hfov_deg) / 2.0
+        psi = np.radians(p[:, 2] + head_pan_deg)
+        log_floor = math.log(self.outlier)
+        noise = math.radians(self.noise_deg)
+        observed_pairs = obs.pairs
+        offsets = np.radians(obs.offsets_deg)
+        for pair in np.unique(observed_pairs):
+            k = observed_pairs == pair
+            m = lm.pairs == pair
+            if not m.any():
+                total += log_floor * int(k.sum())
+                continue
+            d = lm.positions[m][None, :, :] - p[:, None, :2]  # (N, M, 2)
+            dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
+            predicted = np.angle(np.exp(1j * (np.arctan2(d[..., 1], d[..., 0]) - psi[:, None])))
+            sigma2 = noise**2 + (lm.std_m[m][None, :] / dist) ** 2  # (N, M)
+            # (N, K, M): every observed change against every landmark of its pair
+            err = np.angle(np.exp(1j * (offsets[k][None, :, None] - predicted[:, None, :])))
+            score = -0.5 * err**2 / sigma2[:, None, :] - 0.5 * np.log(sigma2[:, None, :] / noise**2)
+            score = np.where(np.abs(predicted)[:, None, :] <= half, score, -np.inf)
+            best = score.max(axis=2)  # (N, K)
+            total += np.logaddexp(best, log_floor).sum(axis=1)
+        return total
