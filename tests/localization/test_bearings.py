@@ -154,3 +154,20 @@ def test_bad_inputs_are_refused(learned):
         learn_landmarks([])
     with pytest.raises(ValueError, match="band_deg"):
         frame_bearings(np.zeros((40, 52, 3), np.uint8), Camera(), colors, band_deg=(5.0, 1.0))
+
+
+def test_the_camera_ahead_of_the_body_is_where_the_bearings_are_seen_from(striped, learned):
+    room, _ = striped
+    colors, views = learned
+    ahead = 0.25  # the simulated robot's eye, ahead of its trunk's centre
+    camera = Camera(hfov_deg=HFOV)
+    sensor = BearingSensor(learn_landmarks(views), colors, camera, eye_forward_m=ahead)
+    x, y, yaw = -0.5, -0.3, 60.0  # the body
+    t = math.radians(yaw)
+    img, _ = view(room, x + ahead * math.cos(t), y + ahead * math.sin(t), yaw)
+    gx, gy = np.meshgrid(np.arange(-0.3, 0.31, 0.01), np.arange(-0.3, 0.31, 0.01))
+    poses = np.stack([x + gx.ravel(), y + gy.ravel(), np.full(gx.size, yaw)], 1)
+    best = poses[np.argmax(sensor.pose_log_likelihood(img, poses))]
+    assert math.hypot(best[0] - x, best[1] - y) < 0.04, best
+    with pytest.raises(ValueError, match="eye_forward_m"):
+        BearingSensor(sensor.landmarks, colors, eye_forward_m=float("nan"))

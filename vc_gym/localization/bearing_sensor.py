@@ -24,7 +24,7 @@ from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, frame_beari
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.localization.landmarks import LandmarkMap
-from vc_gym.validation import positive_float
+from vc_gym.validation import finite_float, positive_float
 
 __all__ = ["BearingSensor"]
 
@@ -47,6 +47,9 @@ class BearingSensor:
         landmark explains, in ``(0, 1)``.
     band_deg : tuple of float
         The horizon band the changes are read in (see ``frame_bearings``).
+    eye_forward_m : float
+        How far ahead of the body's centre, along its heading, the camera sits (a
+        pose is the body's; the bearings are seen from the camera).
     """
 
     def __init__(
@@ -57,6 +60,7 @@ class BearingSensor:
         noise_deg: float = 0.5,
         outlier: float = 0.05,
         band_deg: tuple[float, float] = DEFAULT_BAND_DEG,
+        eye_forward_m: float = 0.0,
     ):
         if not isinstance(landmarks, LandmarkMap):
             raise ValueError(f"landmarks must be a LandmarkMap, got {type(landmarks).__name__}")
@@ -74,6 +78,7 @@ class BearingSensor:
             raise ValueError(f"outlier must be in (0, 1), got {outlier}")
         self.outlier = outlier
         self.band_deg = band_deg
+        self.eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
 
     def bearings(self, image: np.ndarray) -> FrameBearings:
         """The changes of one frame (what :meth:`pose_log_likelihood` reads)."""
@@ -114,7 +119,9 @@ class BearingSensor:
             return total
         lm = self.landmarks
         half = math.radians(obs.hfov_deg) / 2.0
-        psi = np.radians(p[:, 2] + head_pan_deg)
+        theta = np.radians(p[:, 2])
+        eye = p[:, :2] + self.eye_forward_m * np.stack([np.cos(theta), np.sin(theta)], 1)
+        psi = theta + math.radians(head_pan_deg)
         log_floor = math.log(self.outlier)
         noise = math.radians(self.noise_deg)
         observed_pairs = obs.pairs
@@ -125,7 +132,7 @@ class BearingSensor:
             if not m.any():
                 total += log_floor * int(k.sum())
                 continue
-            d = lm.positions[m][None, :, :] - p[:, None, :2]  # (N, M, 2)
+            d = lm.positions[m][None, :, :] - eye[:, None, :]  # (N, M, 2)
             dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
             predicted = np.angle(np.exp(1j * (np.arctan2(d[..., 1], d[..., 0]) - psi[:, None])))
             sigma2 = noise**2 + (lm.std_m[m][None, :] / dist) ** 2  # (N, M)
