@@ -18,6 +18,12 @@ Maps (``--maps``):
 * ``spot``: each spot's own map only, re-drawn with the distances learned from its turns;
 * ``dense``: ``spot`` plus each turn around a spot as a map of its own (0.5 m apart).
 
+``--sensor bearings`` scores the same grid with the landmarks' bearings instead
+(:class:`~vc_gym.localization.bearing_sensor.BearingSensor`): the colour changes of the
+atlas' learning turns (re-rendered at the atlas' spots and turns, every 15°, with the
+atlas' colour classes) triangulated into landmarks; ``--sensor both`` prints the two
+side by side on the same walk.
+
 ``--spots`` chooses the map each candidate is scored with: ``nearest`` (the pose
 tracker's rule: the spot nearest the candidate), ``fixed`` (the spot nearest the truth,
 for every candidate: no switching between maps inside the grid), ``offset`` (nearest,
@@ -27,6 +33,7 @@ likelihood counts, not its level) or ``best2`` (the better of the two nearest sp
     python scripts/pose_likelihood_diagnostic.py robolab --seed 100 --windows 1 20 60 150
     python scripts/pose_likelihood_diagnostic.py robolab --seed 100 --maps dense
     python scripts/pose_likelihood_diagnostic.py robolab --seed 100 --spots fixed
+    python scripts/pose_likelihood_diagnostic.py plain_house --seed 100 --sensor both --grid 0.02
 """
 
 from __future__ import annotations
@@ -39,6 +46,7 @@ import numpy as np
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassAtlas
+from vc_gym.compass.bearings import frame_bearings
 from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.pose_maps import PoseMaps, around_groups
 from vc_gym.envs.learning import HEAD_SCAN_DEG
@@ -46,7 +54,10 @@ from vc_gym.experiments.atlases import atlas_spec, learn_atlas_job
 from vc_gym.experiments.studies.common import scene_field_bounds
 from vc_gym.experiments.studies.orientation_grid import GRID_AROUND_M, training_spots
 from vc_gym.exposure import SessionLight
+from vc_gym.localization.bearing_sensor import BearingSensor
+from vc_gym.localization.landmarks import LearnedView, learn_landmarks
 from vc_gym.sim.aibo_room import AiboRoomEnv
+from vc_gym.sim.robot import EYE_OFFSET_M
 
 HEADING_OFFSETS_DEG = np.arange(-6.0, 6.5, 2.0)
 GRID_STEP_M = 0.05
@@ -88,6 +99,48 @@ def pose_maps(atlas: CompassAtlas, kind: str) -> PoseMaps:
     return PoseMaps(maps)
 
 
+def bearing_sensor(room: AiboRoomEnv, atlas: CompassAtlas, camera: Camera) -> BearingSensor:
+    """Landmarks from turns at every position of the atlas (its spots and the turns around
+    them), seen with the atlas' colour classes, as a sensor."""
+    colors = atlas.compasses[0].colors
+    views = []
+    for x, y in atlas.positions:
+        for yaw in range(0, 360, 15):
+            obs, _ = room.reset(seed=0, options={"pose": (float(x), float(y), float(yaw))})
+            eye, eye_yaw, pitch = room.robot.eye()
+            found = frame_bearings(obs["image"], camera.replace(pitch_deg=pitch), colors)
+            views.append(LearnedView(found, eye_yaw, eye[0], eye[1]))
+    landmarks = learn_landmarks(views)
+    print(f"{len(landmarks)} landmarks from {len(views)} learning frames "
+          f"(median uncertainty {np.median(landmarks.std_m):.3f} m)")
+    return BearingSensor(landmarks, colors, camera, eye_forward_m=EYE_OFFSET_M[0])
+
+
+def bearing_scores(sensor, image, camera, pitch, xy, body_heading, pan) -> np.ndarray:
+    """``(cells, headings)`` log-likelihoods of the grid from the frame's bearings."""
+    found = frame_bearings(image, camera.replace(pitch_deg=pitch), sensor.colors)
+    poses = np.column_stack([np.repeat(xy, len(body_heading), axis=0),
+                             np.tile(body_heading, len(xy))])
+    return sensor.pose_log_likelihood(found, poses, pan).reshape(len(xy), len(body_heading))
+
+
+def summary(name: str, frames: list[np.ndarray], windows, offsets) -> None:
+    """The table of one sensor: distance of the summed likelihood's maximum from the truth."""
+    print(f"{name}: {len(frames)} frames")
+    print("window (frames) | median m off | mean m off | within 0.15 m | within 0.05 m"
+          " | mean |heading off|")
+    for w in windows:
+        off, head = [], []
+        for end in range(w, len(frames) + 1):
+            total = np.sum(frames[end - w:end], axis=0)
+            cell, h = np.unravel_index(np.argmax(total), total.shape)
+            off.append(math.hypot(*offsets[cell]))
+            head.append(abs(HEADING_OFFSETS_DEG[h]))
+        off = np.asarray(off)
+        print(f"{w:15d} | {np.median(off):12.3f} | {off.mean():10.3f} | "
+              f"{np.mean(off <= 0.15):13.0%} | {np.mean(off <= 0.05):13.0%} | {np.mean(head):.1f}°")
+
+
 def scored(maps, terms, xy, camera_heading, truth, rule: str) -> np.ndarray:
     """``(cells, headings)`` log-likelihoods of the grid under the spot rule ``rule``."""
     def under(spot):
@@ -121,6 +174,9 @@ def main() -> None:
     ap.add_argument("--windows", type=int, nargs="+", default=[1, 20, 60, 150])
     ap.add_argument("--reach", type=float, default=0.6, help="half-width of the grid, m")
     ap.add_argument("--cache", type=Path, default=Path("vc_gym_diagnostic_atlases"))
+    ap.add_argument("--sensor", choices=["sectors", "bearings", "both"], default="sectors",
+                    help="sector histograms (the maps), the landmarks' bearings, or both")
+    ap.add_argument("--grid", type=float, default=GRID_STEP_M, help="grid step, m")
     a = ap.parse_args()
 
     atlas = load_atlas(a.scene, a.seed, a.exposure, a.cache)
@@ -129,14 +185,16 @@ def main() -> None:
     room = AiboRoomEnv(scene=a.scene)
     camera = Camera(hfov_deg=room.camera.hfov_deg)
     light = SessionLight(100)
-    axis = np.arange(-a.reach, a.reach + 1e-9, GRID_STEP_M)
+    sensors = ["sectors", "bearings"] if a.sensor == "both" else [a.sensor]
+    bearings = bearing_sensor(room, atlas, camera) if "bearings" in sensors else None
+    axis = np.arange(-a.reach, a.reach + 1e-9, a.grid)
     gx, gy = np.meshgrid(axis, axis, indexing="ij")
     offsets = np.c_[gx.ravel(), gy.ravel()]
 
     rng = np.random.default_rng(a.seed)
     _, info = room.reset(seed=a.seed, options={"pose": (0.0, 0.0, 30.0)})
     waypoint = rng.uniform([x0, y0], [x1, y1])
-    frames: list[np.ndarray] = []
+    frames: dict[str, list[np.ndarray]] = {name: [] for name in sensors}
     for f in range(a.frames):
         pose = info["pose"]
         d = waypoint - pose[:2]
@@ -151,30 +209,31 @@ def main() -> None:
             room.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
         )
         truth = np.asarray(info["pose"], dtype=np.float64)
+        xy = truth[:2] + offsets
+        pan = float(obs["head"][0])
+        if bearings is not None:
+            pitch = room.robot.eye()[2]
+            body = truth[2] + HEADING_OFFSETS_DEG
+            frames["bearings"].append(
+                bearing_scores(bearings, obs["image"], camera, pitch, xy, body, pan)
+            )
+        if "sectors" not in sensors:
+            continue
         gain = None
         if maps.config.exposure == "session":
             gain = light.update(maps.maps[0].frame_gain(obs["image"], camera))
         terms = maps.frame(obs["image"], camera, None, gain)
-        if not terms.has_evidence:
-            continue
-        xy = truth[:2] + offsets
-        camera_heading = (truth[2] + float(obs["head"][0]) + HEADING_OFFSETS_DEG) % 360.0
-        frames.append(scored(maps, terms, xy, camera_heading, truth, a.spots))
+        camera_heading = (truth[2] + pan + HEADING_OFFSETS_DEG) % 360.0
+        if terms.has_evidence:
+            frames["sectors"].append(scored(maps, terms, xy, camera_heading, truth, a.spots))
+        else:  # no evidence: the same for every pose
+            frames["sectors"].append(np.zeros((len(xy), len(camera_heading))))
     room.close()
 
-    print(f"{a.scene}, seed {a.seed}, exposure {a.exposure}, maps {a.maps}"
-          f", spots {a.spots}: {len(frames)} frames")
-    print("window (frames) | median m off | mean m off | within 0.15 m | mean |heading off|")
-    for w in a.windows:
-        off, head = [], []
-        for end in range(w, len(frames) + 1):
-            total = np.sum(frames[end - w:end], axis=0)
-            cell, h = np.unravel_index(np.argmax(total), total.shape)
-            off.append(math.hypot(*offsets[cell]))
-            head.append(abs(HEADING_OFFSETS_DEG[h]))
-        off = np.asarray(off)
-        print(f"{w:15d} | {np.median(off):12.2f} | {off.mean():10.2f} | "
-              f"{np.mean(off <= 0.15):13.0%} | {np.mean(head):.1f}°")
+    print(f"{a.scene}, seed {a.seed}, exposure {a.exposure}, maps {a.maps}, spots {a.spots}, "
+          f"grid {a.grid} m; the motion known exactly (0.1 s a frame)")
+    for name in sensors:
+        summary(name, frames[name], a.windows, offsets)
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["HeadingSensor", "PoseSensor", "check_log_likelihood"]
+__all__ = ["HeadingSensor", "PoseSensor", "check_log_likelihood", "check_pose_query"]
 
 
 @runtime_checkable
@@ -86,3 +86,25 @@ def check_log_likelihood(ll: object, n: int, who: str = "sensor") -> np.ndarray:
     if np.isposinf(a).any():
         raise ValueError(f"{who} returned +inf log-likelihoods")
     return a
+
+
+def check_pose_query(poses: object, head_pan_deg: object) -> tuple[np.ndarray, float]:
+    """Validate a pose sensor's question: ``(N, 3)`` finite poses and a finite head pan.
+
+    Returns them as a ``float64`` array and a float.
+
+    Raises
+    ------
+    ValueError
+        Naming the wrong shape, the non-finite poses or the head pan.
+    """
+    p = np.asarray(poses, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("poses must be finite")
+    if isinstance(head_pan_deg, bool) or not isinstance(head_pan_deg, (int, float, np.number)):
+        raise ValueError(f"head_pan_deg must be a number, got {head_pan_deg!r}")
+    if not np.isfinite(head_pan_deg):
+        raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
+    return p, float(head_pan_deg)

@@ -23,6 +23,7 @@ import numpy as np
 from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, frame_bearings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
+from vc_gym.filters.sensor_protocol import check_pose_query
 from vc_gym.localization.landmarks import LandmarkMap
 from vc_gym.validation import finite_float, positive_float
 
@@ -106,13 +107,7 @@ class BearingSensor:
         numpy.ndarray
             ``(N,)`` log-likelihoods; 0 for every pose when the frame shows no change.
         """
-        p = np.asarray(poses, dtype=np.float64)
-        if p.ndim != 2 or p.shape[1] != 3:
-            raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
-        if not np.all(np.isfinite(p)):
-            raise ValueError("poses must be finite")
-        if not math.isfinite(head_pan_deg):
-            raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
+        p, head_pan_deg = check_pose_query(poses, head_pan_deg)
         obs = observation if isinstance(observation, FrameBearings) else self.bearings(observation)
         total = np.zeros(len(p))
         if len(obs) == 0:

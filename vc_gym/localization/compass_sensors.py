@@ -15,6 +15,7 @@ import numpy as np
 
 from vc_gym.angles import interp_circular
 from vc_gym.compass import AtlasEstimate, Camera, CompassAtlas, ImageCompass
+from vc_gym.filters.sensor_protocol import check_pose_query
 from vc_gym.validation import positive_float
 
 __all__ = [
@@ -172,11 +173,7 @@ class AtlasPoseSensor:
             Head pan when the frame was taken (left positive): the camera looked at
             ``θ + head_pan_deg``.
         """
-        p = np.asarray(poses, dtype=np.float64)
-        if p.ndim != 2 or p.shape[1] != 3:
-            raise ValueError(f"poses must have shape (N, 3), got {p.shape}")
-        if not math.isfinite(head_pan_deg):
-            raise ValueError(f"head_pan_deg must be finite, got {head_pan_deg!r}")
+        p, head_pan_deg = check_pose_query(poses, head_pan_deg)
         if isinstance(observation, AtlasEstimate):
             est = observation
         else:
