@@ -26,6 +26,9 @@ _WHAT = {
     "physics and render, and the speed-up of 2 async envs.",
     "trackers": "cost of one update of every registered tracker (grid, particle, kalman) on "
     "the same walk through a ray-cast room with a 4-spot atlas, next to the atlas alone.",
+    "bearings": "cost per frame of reading a frame's colour changes as bearings and of "
+    "scoring --poses candidate poses with the landmarks learned from the pose-home mode's "
+    "turns (rendered at their true poses in the robot lab), over --frames frames.",
     "backends": "jobs per second of the homing experiment's episodes with 1 local worker, "
     "--workers local workers and a local Ray instance of --workers CPUs (atlas learned "
     "once; the results must be byte-identical).",
@@ -54,6 +57,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="FILE", help="also save the JSON to FILE")
     p.add_argument("--frames", type=int, default=40, help="compass: distinct test frames")
     p.add_argument("--repeats", type=int, default=15, help="timed rounds (medians are reported)")
+    p.add_argument(
+        "--poses", type=int, default=500, help="bearings: candidate poses scored per frame"
+    )
     p.add_argument("--plot", metavar="PNG", help="filters: save a plot of the tracking run")
     p.add_argument(
         "--episodes", type=int, default=12, help="backends: homing episodes (jobs) per backend"
@@ -83,6 +89,11 @@ def _check_bench_args(args: argparse.Namespace) -> None:
         from vc_gym.experiments.benchmarks.compass import MAX_FRAMES
 
         int_in_range("--frames", args.frames, 1, MAX_FRAMES)
+    elif args.what == "bearings":
+        from vc_gym.experiments.benchmarks.bearings import MAX_FRAMES, MAX_POSES
+
+        int_in_range("--frames", args.frames, 1, MAX_FRAMES)
+        int_in_range("--poses", args.poses, 1, MAX_POSES)
     elif args.what == "backends":
         from vc_gym.jobs.workers import check_workers
 
@@ -151,6 +162,13 @@ def _measure(args: argparse.Namespace) -> dict:
         from vc_gym.experiments.benchmarks.trackers import bench_trackers
 
         return bench_trackers(repeats=max(1, args.repeats // 3), seed=args.seed)
+    if args.what == "bearings":
+        from vc_gym.experiments.benchmarks.bearings import bench_bearings
+
+        return bench_bearings(
+            frames=args.frames, repeats=args.repeats, poses=args.poses, seed=args.seed,
+            progress=progress,
+        )  # fmt: skip
     if args.what == "backends":
         from vc_gym.experiments.benchmarks.backends import bench_backends
 
@@ -201,6 +219,13 @@ def _summary_lines(what: str, result: dict) -> list[str]:
             f"{v['final_heading_error_deg']:.1f}°, position error "
             f"{v['final_position_error_m'] * 100:.0f} cm"
             for name, v in result["trackers"].items()
+        ]
+    if what == "bearings":
+        return [
+            f"bearings {result['bearings_ms']:.3f} ms per frame ({result['changes_per_frame']:g} "
+            f"colour changes a frame), likelihood of {result['poses']} poses "
+            f"{result['likelihood_ms']:.3f} ms per frame; {result['landmarks']} landmarks "
+            f"from {result['learning_frames']} learning frames ({result['scene']})"
         ]
     if what == "backends":
         lines = []
