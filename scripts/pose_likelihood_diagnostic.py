@@ -47,6 +47,7 @@ import numpy as np
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.compass.bearings import frame_bearings
+from vc_gym.compass.landmarks import LearnedView, learn_landmarks
 from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.pose_maps import PoseMaps, around_groups
 from vc_gym.envs.learning import HEAD_SCAN_DEG
@@ -55,7 +56,6 @@ from vc_gym.experiments.studies.common import scene_field_bounds
 from vc_gym.experiments.studies.orientation_grid import GRID_AROUND_M, training_spots
 from vc_gym.exposure import SessionLight
 from vc_gym.localization.bearing_sensor import BearingSensor
-from vc_gym.localization.landmarks import LearnedView, learn_landmarks
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.sim.robot import EYE_OFFSET_M
 

@@ -69,3 +69,48 @@ def test_truncated_file(saved, tmp_path):
     bad.write_bytes(saved.read_bytes()[:200])
     with pytest.raises(MapFileError, match="cut.npz"):
         CompassAtlas.load(bad)
+
+
+def _with_landmarks(atlas, tmp_path, **changes):
+    from vc_gym.compass.landmarks import LandmarkMap
+
+    n = atlas.compasses[0].config.n_colors
+    fields = {
+        "positions": np.array([[2.0, -1.0], [-2.5, 0.5]]),
+        "pairs": np.array([3, n * n - 1]),
+        "std_m": np.array([0.01, 0.02]),
+        "support": np.array([4, 7]),
+        "n_colors": n,
+    }
+    fields.update(changes)
+    atlas.landmarks = LandmarkMap(**fields)
+    try:
+        return atlas.save(tmp_path / "with_landmarks.npz")
+    finally:
+        atlas.landmarks = None
+
+
+def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
+    assert CompassAtlas.load(saved).landmarks is None  # an atlas learned without them
+    loaded = CompassAtlas.load(_with_landmarks(room_atlas, tmp_path)).landmarks
+    np.testing.assert_array_equal(loaded.positions, [[2.0, -1.0], [-2.5, 0.5]])
+    assert loaded.pairs.tolist()[0] == 3 and loaded.support.tolist() == [4, 7]
+    assert loaded.n_colors == room_atlas.compasses[0].config.n_colors
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"positions": np.array([[np.nan, 0.0], [1.0, 1.0]])}, "finite"),
+        ({"positions": np.array([[1e9, 0.0], [1.0, 1.0]])}, "finite"),
+        ({"pairs": np.array([3, 10_000])}, "colour classes"),
+        ({"pairs": np.array([-1, 3])}, "colour classes"),
+        ({"std_m": np.array([-0.1, 0.1])}, "std_m"),
+        ({"support": np.array([1, 5])}, "2 positions"),
+        ({"std_m": np.array([0.1])}, "count"),
+    ],
+)
+def test_bad_landmarks_in_a_file_are_refused(room_atlas, tmp_path, changes, message):
+    path = _with_landmarks(room_atlas, tmp_path, **changes)
+    with pytest.raises(MapFileError, match=message):
+        CompassAtlas.load(path)

@@ -19,6 +19,7 @@ import numpy as np
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.config import MAX_MAP_BYTES, CompassConfig
+from vc_gym.compass.landmarks import LandmarkMap
 from vc_gym.compass.likelihood import log_likelihoods
 from vc_gym.compass.visual_compass import CompassEstimate, VisualCompass, _estimates_of
 from vc_gym.errors import MapFileError, NotLearnedError
@@ -173,6 +174,10 @@ class CompassAtlas:
         self._home_scores = np.zeros((0, len(names)))
         self._home_headings = np.zeros((0, len(names)))
         self._kappa = 1.0
+        #: The colour changes of the learning turns placed in the room
+        #: (:func:`~vc_gym.compass.landmarks.learn_landmarks`), if they were learned;
+        #: saved with the atlas.
+        self.landmarks: LandmarkMap | None = None
         self.is_normalized = False
         self._stacked: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray] | None = None
 
@@ -445,6 +450,8 @@ class CompassAtlas:
         for i, vc in enumerate(self.compasses):
             for key, a in vc.to_arrays(with_colors=not shared).items():
                 arrays[f"spot{i}/{key}"] = a
+        if self.landmarks is not None:
+            arrays.update(self.landmarks.to_arrays())
         return save_npz_atomic(path, ATLAS_SCHEMA, ATLAS_SCHEMA_VERSION, arrays)
 
     @classmethod
@@ -532,6 +539,11 @@ class CompassAtlas:
         atlas._home_headings = headings.astype(np.float64)
         atlas._kappa = kappa
         atlas.is_normalized = normalized
+        if any(k.startswith("landmarks/") for k in arrays):
+            try:
+                atlas.landmarks = LandmarkMap.from_arrays(arrays, config.n_colors)
+            except ValueError as e:
+                raise MapFileError(f"{path}: {e}") from None
         return atlas, metadata
 
 

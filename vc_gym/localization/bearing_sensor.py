@@ -23,8 +23,8 @@ import numpy as np
 from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, frame_bearings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
+from vc_gym.compass.landmarks import LandmarkMap
 from vc_gym.filters.sensor_protocol import check_pose_query
-from vc_gym.localization.landmarks import LandmarkMap
 from vc_gym.validation import finite_float, positive_float
 
 __all__ = ["BearingSensor"]
@@ -109,32 +109,9 @@ class BearingSensor:
         """
         p, head_pan_deg = check_pose_query(poses, head_pan_deg)
         obs = observation if isinstance(observation, FrameBearings) else self.bearings(observation)
-        total = np.zeros(len(p))
-        if len(obs) == 0:
-            return total
-        lm = self.landmarks
-        half = math.radians(obs.hfov_deg) / 2.0
         theta = np.radians(p[:, 2])
         eye = p[:, :2] + self.eye_forward_m * np.stack([np.cos(theta), np.sin(theta)], 1)
-        psi = theta + math.radians(head_pan_deg)
-        log_floor = math.log(self.outlier)
-        noise = math.radians(self.noise_deg)
-        observed_pairs = obs.pairs
-        offsets = np.radians(obs.offsets_deg)
-        for pair in np.unique(observed_pairs):
-            k = observed_pairs == pair
-            m = lm.pairs == pair
-            if not m.any():
-                total += log_floor * int(k.sum())
-                continue
-            d = lm.positions[m][None, :, :] - eye[:, None, :]  # (N, M, 2)
-            dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
-            predicted = np.angle(np.exp(1j * (np.arctan2(d[..., 1], d[..., 0]) - psi[:, None])))
-            sigma2 = noise**2 + (lm.std_m[m][None, :] / dist) ** 2  # (N, M)
-            # (N, K, M): every observed change against every landmark of its pair
-            err = np.angle(np.exp(1j * (offsets[k][None, :, None] - predicted[:, None, :])))
-            score = -0.5 * err**2 / sigma2[:, None, :] - 0.5 * np.log(sigma2[:, None, :] / noise**2)
-            score = np.where(np.abs(predicted)[:, None, :] <= half, score, -np.inf)
-            best = score.max(axis=2)  # (N, K)
-            total += np.logaddexp(best, log_floor).sum(axis=1)
-        return total
+        camera_yaw = theta + math.radians(head_pan_deg)
+        return self.landmarks.log_likelihood(
+            obs, eye, camera_yaw, math.radians(self.noise_deg), self.outlier
+        )

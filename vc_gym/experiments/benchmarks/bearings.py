@@ -3,7 +3,7 @@
 The learning turns of the ``pose-home`` mode are rendered at their true poses (home and
 the four spots 1 m around it, each with the turns 0.5 m around it, every 30°); their
 colour changes are triangulated into landmarks
-(:func:`~vc_gym.localization.landmarks.learn_landmarks`). Frames from seeded random
+(:func:`~vc_gym.compass.landmarks.learn_landmarks`). Frames from seeded random
 poses of the field are rendered once; each round then reads every frame's changes
 (:func:`~vc_gym.compass.bearings.frame_bearings`) and scores ``poses`` candidate poses
 around the truth (:class:`~vc_gym.localization.bearing_sensor.BearingSensor`). The
@@ -21,8 +21,8 @@ from tqdm import tqdm
 from vc_gym.compass import Camera
 from vc_gym.compass.bearings import frame_bearings
 from vc_gym.compass.colors import ColorClasses
+from vc_gym.compass.landmarks import LearnedView, learn_landmarks
 from vc_gym.localization.bearing_sensor import BearingSensor
-from vc_gym.localization.landmarks import LearnedView, learn_landmarks
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.sim.robot import EYE_OFFSET_M
 from vc_gym.sim.scenes import check_scene_name
