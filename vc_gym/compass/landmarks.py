@@ -402,6 +402,13 @@ def _turn_scores(
     return total
 
 
+def _spread(n: int, most: int) -> np.ndarray:
+    """At most ``most`` of ``range(n)``, evenly spread."""
+    if n == 0:
+        return np.zeros(0, int)
+    return np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
+
+
 def _grid(centre: np.ndarray, reach_m: float, step_m: float, reach_deg: float, step_deg: float):
     xy = np.arange(-reach_m, reach_m + 1e-9, step_m)
     yaw = np.arange(-reach_deg, reach_deg + 1e-9, step_deg)
@@ -417,6 +424,7 @@ def place_turns(
     rounds: int = 2,
     noise_deg: float = 0.3,
     outlier: float = 0.05,
+    max_frames: int = 24,
 ) -> tuple[LandmarkMap, np.ndarray]:
     """Landmarks from turns whose believed poses drifted, with each turn placed anew.
 
@@ -442,6 +450,9 @@ def place_turns(
         Placements of the turns against the landmarks (at least 1).
     noise_deg, outlier : float
         The likelihood's bearing noise and outlier floor.
+    max_frames : int
+        Frames of a turn (evenly spread over it) its placement is scored on; the
+        landmarks are learned from every frame.
 
     Returns
     -------
@@ -456,6 +467,11 @@ def place_turns(
     reach_deg = positive_float("search_deg", search_deg)
     int_at_least("rounds", rounds, 1)
     noise = math.radians(positive_float("noise_deg", noise_deg))
+    int_at_least("max_frames", max_frames, 1)
+    scored = [
+        LearnedTurn(t.x, t.y, tuple(t.frames[i] for i in _spread(len(t.frames), max_frames)))
+        for t in turns
+    ]
     corrections = np.zeros((len(turns), 3))
     # home alone: each edge is seen from two or three camera positions a few decimetres
     # apart (rough, but enough to place the other turns near their truth)
@@ -466,11 +482,11 @@ def place_turns(
             coarse = _grid(
                 corrections[k], reach * scale, 0.05 * scale, reach_deg * scale, 1.0 * scale
             )
-            ll = _turn_scores(landmarks, turns[k], coarse, eye_forward_m, noise, outlier)
+            ll = _turn_scores(landmarks, scored[k], coarse, eye_forward_m, noise, outlier)
             fine = _grid(
                 coarse[np.argmax(ll)], 0.05 * scale, 0.01 * scale, 1.0 * scale, 0.25 * scale
             )
-            ll = _turn_scores(landmarks, turns[k], fine, eye_forward_m, noise, outlier)
+            ll = _turn_scores(landmarks, scored[k], fine, eye_forward_m, noise, outlier)
             corrections[k] = fine[np.argmax(ll)]
         views = [
             v
