@@ -206,3 +206,24 @@ def test_turns_whose_believed_poses_drifted_are_placed_anew(striped, learned):
     believed = learn_landmarks([v for t in turns for v in t.views(ahead)])
     off = np.min(np.hypot(*(believed.positions[:, None, :] - points[None]).transpose(2, 0, 1)), 1)
     assert np.median(off) > 3 * np.median(gaps)
+
+
+def test_many_rays_are_triangulated_within_bounded_work():
+    """1,200 rays of one colour pair (720,000 pairs of rays) from 400 positions: the
+    candidates are drawn (MAX_CANDIDATES) and scored in chunks, and every landmark is
+    still found."""
+    from vc_gym.compass.bearings import FrameBearings
+    from vc_gym.compass.landmarks import MAX_CANDIDATES
+
+    rng = np.random.default_rng(2)
+    marks = np.array([[3.0, 1.0], [2.5, -1.5], [-3.0, 0.5]])
+    views = []
+    for x, y in rng.uniform(-1.0, 1.0, (400, 2)):
+        world = np.degrees(np.arctan2(marks[:, 1] - y, marks[:, 0] - x))
+        found = FrameBearings(world.copy(), np.zeros(3, np.int64), np.ones(3, np.int64), 4, 360.0)
+        views.append(LearnedView(found, 0.0, float(x), float(y)))
+    assert 1200 * 1199 // 2 > MAX_CANDIDATES
+    lm = learn_landmarks(views)
+    assert len(lm) == 3
+    gaps = np.min(np.hypot(*(lm.positions[:, None, :] - marks[None]).transpose(2, 0, 1)), 1)
+    assert np.max(gaps) < 0.01 and np.all(lm.support >= 300)

@@ -22,6 +22,7 @@ from vc_gym.compass.bearings import FrameBearings
 from vc_gym.validation import MAX_ABS_METRES, int_at_least, positive_float
 
 __all__ = [
+    "MAX_CANDIDATES",
     "MAX_LANDMARKS",
     "LandmarkMap",
     "LearnedTurn",
@@ -235,10 +236,26 @@ def _merge_repeats(o: np.ndarray, a: np.ndarray, merge: float) -> tuple[np.ndarr
     return np.asarray(out_o, np.float64).reshape(-1, 2), np.asarray(out_a, np.float64)
 
 
-def _intersections(o: np.ndarray, a: np.ndarray, min_angle: float, max_range: float):
-    """Points where two rays of different origins cross in front of both."""
+#: Most candidate crossings scored per landmark found (pairs of rays beyond this are
+#: drawn at random, seeded): bounds the memory and time a map with many rays needs.
+MAX_CANDIDATES = 20_000
+#: Most candidate x ray entries scored at once.
+_CHUNK = 2_000_000
+
+
+def _intersections(
+    o: np.ndarray, a: np.ndarray, min_angle: float, max_range: float, rng: np.random.Generator
+) -> np.ndarray:
+    """Points where two rays of different origins cross in front of both (at most
+    :data:`MAX_CANDIDATES` pairs of rays, drawn at random when there are more)."""
+    n = len(a)
+    if n * (n - 1) // 2 <= MAX_CANDIDATES:
+        i, j = np.triu_indices(n, k=1)
+    else:
+        i, j = rng.integers(0, n, (2, MAX_CANDIDATES))
+        keep = i != j
+        i, j = i[keep], j[keep]
     d = np.stack([np.cos(a), np.sin(a)], axis=1)
-    i, j = np.triu_indices(len(a), k=1)
     cross = d[i, 0] * d[j, 1] - d[i, 1] * d[j, 0]
     ok = (np.abs(cross) > math.sin(min_angle)) & (np.hypot(*(o[i] - o[j]).T) > 1e-6)
     i, j, cross = i[ok], j[ok], cross[ok]
@@ -247,6 +264,29 @@ def _intersections(o: np.ndarray, a: np.ndarray, min_angle: float, max_range: fl
     s = (w[:, 0] * d[i, 1] - w[:, 1] * d[i, 0]) / cross
     front = (t > 0.05) & (s > 0.05) & (t < max_range) & (s < max_range)
     return o[i[front]] + t[front, None] * d[i[front]]
+
+
+def _best_candidate(
+    points: np.ndarray, o: np.ndarray, a: np.ndarray, where: np.ndarray, tol: float
+) -> tuple[int, int, np.ndarray]:
+    """The candidate seen by rays of the most distinct positions: its index, that count
+    and which rays see it (angle to it within ``tol``); scored in chunks."""
+    n_pos = int(where.max()) + 1
+    chunk = max(1, _CHUNK // max(len(a), n_pos))
+    best, best_support, best_sees = -1, -1, np.zeros(len(a), bool)
+    for start in range(0, len(points), chunk):
+        p = points[start : start + chunk]
+        to = p[:, None, :] - o[None, :, :]
+        miss = np.angle(np.exp(1j * (np.arctan2(to[..., 1], to[..., 0]) - a[None])))
+        sees = np.abs(miss) < tol
+        rows, cols = np.nonzero(sees)
+        seen_from = np.zeros((len(p), n_pos), bool)
+        seen_from[rows, where[cols]] = True
+        support = seen_from.sum(axis=1)
+        k = int(np.argmax(support))
+        if support[k] > best_support:
+            best, best_support, best_sees = start + k, int(support[k]), sees[k]
+    return best, best_support, best_sees
 
 
 def _fit(o: np.ndarray, a: np.ndarray, floor_rad: float) -> tuple[np.ndarray, float]:
@@ -309,6 +349,7 @@ def learn_landmarks(
     floor = math.radians(positive_float("resolution_deg", resolution_deg))
     merge = math.radians(positive_float("merge_deg", merge_deg))
     origins, angles, pairs, n_colors = _rays(views)
+    rng = np.random.default_rng(0)  # the candidates drawn when there are too many
     found: list[tuple[np.ndarray, int, float, int]] = []
     for pair in np.unique(pairs):
         sel = np.flatnonzero(pairs == pair)
@@ -319,23 +360,15 @@ def learn_landmarks(
         free = np.ones(len(a), bool)
         while free.sum() >= min_positions:
             idx = np.flatnonzero(free)
-            points = _intersections(o[idx], a[idx], min_angle, max_range)
+            points = _intersections(o[idx], a[idx], min_angle, max_range, rng)
             if len(points) == 0:
                 break
-            # which free rays see each candidate (angle to it within the tolerance)
-            to = points[:, None, :] - o[idx][None, :, :]
-            miss = np.angle(np.exp(1j * (np.arctan2(to[..., 1], to[..., 0]) - a[idx][None])))
-            sees = np.abs(miss) < tol
-            # distinct positions among each candidate's rays
-            at = np.zeros((len(idx), int(where.max()) + 1))
-            at[np.arange(len(idx)), where[idx]] = 1.0
-            support = np.count_nonzero(sees.astype(np.float64) @ at, axis=1)
-            best = int(np.argmax(support))
-            if support[best] < min_positions:
+            _, support, sees = _best_candidate(points, o[idx], a[idx], where[idx], tol)
+            if support < min_positions:
                 break
-            rays = idx[sees[best]]
+            rays = idx[sees]
             point, std = _fit(o[rays], a[rays], floor)
-            found.append((point, int(pair), std, int(support[best])))
+            found.append((point, int(pair), std, support))
             free[rays] = False
     if not found:
         none = np.zeros(0, np.int64)
