@@ -154,6 +154,9 @@ def test_bad_inputs_are_refused(learned):
         learn_landmarks([])
     with pytest.raises(ValueError, match="band_deg"):
         frame_bearings(np.zeros((40, 52, 3), np.uint8), Camera(), colors, band_deg=(5.0, 1.0))
+    for band in ((5.0, 1.0), (1.0,), "high", (0.0, float("inf"))):
+        with pytest.raises(ValueError, match="band_deg"):  # when the sensor is made
+            BearingSensor(learn_landmarks(views), colors, band_deg=band)
 
 
 def test_the_camera_ahead_of_the_body_is_where_the_bearings_are_seen_from(striped, learned):

@@ -27,7 +27,7 @@ from vc_gym.compass.colors import ColorClasses
 from vc_gym.images import check_image
 from vc_gym.validation import int_at_least
 
-__all__ = ["DEFAULT_BAND_DEG", "FrameBearings", "frame_bearings"]
+__all__ = ["DEFAULT_BAND_DEG", "FrameBearings", "check_band", "frame_bearings"]
 
 #: Elevations (degrees above the horizon) of the band whose columns are read: the walls
 #: just above eye height, where a wall of 0.5 m or more fills every column to 3 m away.
@@ -66,10 +66,19 @@ class FrameBearings:
         return self.left.astype(np.int64) * self.n_colors + self.right.astype(np.int64)
 
 
-def _band_rows(camera: Camera, width: int, height: int, band_deg: tuple[float, float]) -> slice:
-    lo, hi = (float(v) for v in band_deg)
+def check_band(band_deg: object) -> tuple[float, float]:
+    """``band_deg`` as two floats ``lo < hi`` in ``(-80, 80)`` degrees, else a ``ValueError``."""
+    try:
+        lo, hi = (float(v) for v in band_deg)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise ValueError(f"band_deg must be two elevations (degrees), got {band_deg!r}") from None
     if not (math.isfinite(lo) and math.isfinite(hi) and -80.0 < lo < hi < 80.0):
         raise ValueError(f"band_deg must be two elevations lo < hi in (-80, 80), got {band_deg}")
+    return lo, hi
+
+
+def _band_rows(camera: Camera, width: int, height: int, band_deg: tuple[float, float]) -> slice:
+    lo, hi = check_band(band_deg)
     f = camera.focal_px(width)
     horizon = camera.horizon_row(width, height)
     top = horizon - f * math.tan(math.radians(hi))

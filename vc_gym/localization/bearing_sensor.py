@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, frame_bearings
+from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, check_band, frame_bearings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.landmarks import LandmarkMap
@@ -78,7 +78,7 @@ class BearingSensor:
         if outlier >= 1.0:
             raise ValueError(f"outlier must be in (0, 1), got {outlier}")
         self.outlier = outlier
-        self.band_deg = band_deg
+        self.band_deg = check_band(band_deg)
         self.eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
 
     def bearings(self, image: np.ndarray) -> FrameBearings:
