@@ -52,6 +52,7 @@ from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.pose_maps import PoseMaps, around_groups
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.experiments.atlases import atlas_spec, learn_atlas_job
+from vc_gym.experiments.benchmarks.bearings import frame_at_pose
 from vc_gym.experiments.studies.common import scene_field_bounds
 from vc_gym.experiments.studies.orientation_grid import GRID_AROUND_M, training_spots
 from vc_gym.exposure import SessionLight
@@ -106,10 +107,10 @@ def bearing_sensor(room: AiboRoomEnv, atlas: CompassAtlas, camera: Camera) -> Be
     views = []
     for x, y in atlas.positions:
         for yaw in range(0, 360, 15):
-            obs, _ = room.reset(seed=0, options={"pose": (float(x), float(y), float(yaw))})
-            eye, eye_yaw, pitch = room.robot.eye()
-            found = frame_bearings(obs["image"], camera.replace(pitch_deg=pitch), colors)
-            views.append(LearnedView(found, eye_yaw, eye[0], eye[1]))
+            image, cam, (ex, ey, eye_yaw), _ = frame_at_pose(
+                room, camera, float(x), float(y), float(yaw)
+            )
+            views.append(LearnedView(frame_bearings(image, cam, colors), eye_yaw, ex, ey))
     landmarks = learn_landmarks(views)
     print(f"{len(landmarks)} landmarks from {len(views)} learning frames "
           f"(median uncertainty {np.median(landmarks.std_m):.3f} m)")

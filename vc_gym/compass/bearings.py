@@ -130,9 +130,9 @@ def frame_bearings(
     if rows.stop - rows.start < 1:
         return FrameBearings(np.zeros(0), empty, empty, n, camera.hfov_deg)
     classes = colors.classify(img[rows]).astype(np.int64)  # (R, W)
-    counts = np.zeros((n, width), np.float64)
-    np.add.at(counts, (classes, np.broadcast_to(np.arange(width), classes.shape)), 1.0)
-    share = counts / classes.shape[0]
+    # how many band rows show each class, per column
+    counts = np.bincount((classes * width + np.arange(width)).ravel(), minlength=n * width)
+    share = counts.reshape(n, width) / classes.shape[0]
     column_class = np.argmax(share, axis=0)
     # runs of one class: [start, end) column ranges
     cut = np.flatnonzero(column_class[1:] != column_class[:-1]) + 1

@@ -27,6 +27,7 @@ __all__ = [
     "LandmarkMap",
     "LearnedTurn",
     "LearnedView",
+    "eye_positions",
     "learn_landmarks",
     "place_turns",
 ]
@@ -35,6 +36,15 @@ __all__ = [
 MAX_LANDMARKS = 100_000
 #: The entries of a landmark map in a map file (see :meth:`LandmarkMap.to_arrays`).
 _KEYS = ("positions", "pairs", "std_m", "support")
+
+
+def eye_positions(
+    body_xy: np.ndarray, body_yaw_rad: np.ndarray, eye_forward_m: float
+) -> np.ndarray:
+    """``(N, 2)`` camera positions of bodies at ``body_xy`` (``(N, 2)``, m) heading
+    ``body_yaw_rad`` (``(N,)``): the camera sits ``eye_forward_m`` ahead of the body's
+    centre, along its heading (a pan turns the camera, not where it is)."""
+    return body_xy + eye_forward_m * np.stack([np.cos(body_yaw_rad), np.sin(body_yaw_rad)], 1)
 
 
 @dataclass(frozen=True)
@@ -268,12 +278,12 @@ def _intersections(
 
 def _best_candidate(
     points: np.ndarray, o: np.ndarray, a: np.ndarray, where: np.ndarray, tol: float
-) -> tuple[int, int, np.ndarray]:
-    """The candidate seen by rays of the most distinct positions: its index, that count
+) -> tuple[int, np.ndarray]:
+    """Of the candidates, the one seen by rays of the most distinct positions: that count
     and which rays see it (angle to it within ``tol``); scored in chunks."""
     n_pos = int(where.max()) + 1
     chunk = max(1, _CHUNK // max(len(a), n_pos))
-    best, best_support, best_sees = -1, -1, np.zeros(len(a), bool)
+    best_support, best_sees = -1, np.zeros(len(a), bool)
     for start in range(0, len(points), chunk):
         p = points[start : start + chunk]
         to = p[:, None, :] - o[None, :, :]
@@ -285,8 +295,8 @@ def _best_candidate(
         support = seen_from.sum(axis=1)
         k = int(np.argmax(support))
         if support[k] > best_support:
-            best, best_support, best_sees = start + k, int(support[k]), sees[k]
-    return best, best_support, best_sees
+            best_support, best_sees = int(support[k]), sees[k]
+    return best_support, best_sees
 
 
 def _fit(o: np.ndarray, a: np.ndarray, floor_rad: float) -> tuple[np.ndarray, float]:
@@ -363,7 +373,7 @@ def learn_landmarks(
             points = _intersections(o[idx], a[idx], min_angle, max_range, rng)
             if len(points) == 0:
                 break
-            _, support, sees = _best_candidate(points, o[idx], a[idx], where[idx], tol)
+            support, sees = _best_candidate(points, o[idx], a[idx], where[idx], tol)
             if support < min_positions:
                 break
             rays = idx[sees]
@@ -405,13 +415,13 @@ class LearnedTurn:
         """The frames as views from the camera, the turn moved by ``correction``
         ``(dx m, dy m, dyaw deg)``; the camera sits ``eye_forward_m`` ahead of the body."""
         dx, dy, dyaw = correction
-        out = []
-        for found, yaw, pan in self.frames:
-            t = math.radians(yaw + dyaw)
-            ex = self.x + dx + eye_forward_m * math.cos(t)
-            ey = self.y + dy + eye_forward_m * math.sin(t)
-            out.append(LearnedView(found, yaw + dyaw + pan, ex, ey))
-        return out
+        yaws = np.array([yaw + dyaw for _, yaw, _ in self.frames], np.float64)
+        body = np.broadcast_to([self.x + dx, self.y + dy], (len(yaws), 2))
+        eyes = eye_positions(body, np.radians(yaws), eye_forward_m)
+        return [
+            LearnedView(found, yaw + pan, float(ex), float(ey))
+            for (found, _, pan), yaw, (ex, ey) in zip(self.frames, yaws, eyes, strict=True)
+        ]
 
 
 def _turn_scores(
@@ -425,12 +435,10 @@ def _turn_scores(
     """Log-likelihood of every ``(dx, dy, dyaw deg)`` correction of ``turn``: the sum
     over its frames of :meth:`LandmarkMap.log_likelihood`."""
     total = np.zeros(len(hypotheses))
+    body = np.array([turn.x, turn.y]) + hypotheses[:, :2]
     for found, yaw, pan in turn.frames:
         t = np.radians(yaw + hypotheses[:, 2])
-        eye = np.stack(
-            [turn.x + hypotheses[:, 0] + eye_forward_m * np.cos(t),
-             turn.y + hypotheses[:, 1] + eye_forward_m * np.sin(t)], axis=1,
-        )  # fmt: skip
+        eye = eye_positions(body, t, eye_forward_m)
         total += landmarks.log_likelihood(found, eye, t + math.radians(pan), noise_rad, outlier)
     return total
 

@@ -23,7 +23,7 @@ import numpy as np
 from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, check_band, frame_bearings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
-from vc_gym.compass.landmarks import LandmarkMap
+from vc_gym.compass.landmarks import LandmarkMap, eye_positions
 from vc_gym.filters.sensor_protocol import check_pose_query
 from vc_gym.validation import finite_float, positive_float
 
@@ -110,7 +110,7 @@ class BearingSensor:
         p, head_pan_deg = check_pose_query(poses, head_pan_deg)
         obs = observation if isinstance(observation, FrameBearings) else self.bearings(observation)
         theta = np.radians(p[:, 2])
-        eye = p[:, :2] + self.eye_forward_m * np.stack([np.cos(theta), np.sin(theta)], 1)
+        eye = eye_positions(p[:, :2], theta, self.eye_forward_m)
         camera_yaw = theta + math.radians(head_pan_deg)
         return self.landmarks.log_likelihood(
             obs, eye, camera_yaw, math.radians(self.noise_deg), self.outlier

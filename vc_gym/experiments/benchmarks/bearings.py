@@ -28,7 +28,7 @@ from vc_gym.sim.robot import EYE_OFFSET_M
 from vc_gym.sim.scenes import check_scene_name
 from vc_gym.validation import check_seed, int_in_range
 
-__all__ = ["MAX_FRAMES", "MAX_POSES", "bench_bearings"]
+__all__ = ["MAX_FRAMES", "MAX_POSES", "bench_bearings", "frame_at_pose"]
 
 #: Most test frames (each is rendered and kept in memory).
 MAX_FRAMES = 10_000
@@ -41,8 +41,10 @@ _SPOTS = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))
 _AROUND = ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (-0.5, 0.0), (0.0, -0.5))
 
 
-def _frame(room: AiboRoomEnv, camera: Camera, x: float, y: float, yaw: float):
-    """The head camera's image at a body pose, its camera (pitch) and the eye's pose."""
+def frame_at_pose(room: AiboRoomEnv, camera: Camera, x: float, y: float, yaw: float):
+    """The robot put at the body pose ``(x, y, yaw)`` (head straight): the head camera's
+    image, ``camera`` with the head's pitch, the eye's ``(x, y, yaw)`` and the body's
+    true pose."""
     obs, info = room.reset(seed=0, options={"pose": (x, y, yaw)})
     eye, eye_yaw, pitch = room.robot.eye()
     return obs["image"], camera.replace(pitch_deg=pitch), (eye[0], eye[1], eye_yaw), info["pose"]
@@ -90,7 +92,7 @@ def bench_bearings(
     try:
         camera = Camera(hfov_deg=room.camera.hfov_deg)
         turns = [
-            _frame(room, camera, sx + ax, sy + ay, float(yaw))
+            frame_at_pose(room, camera, sx + ax, sy + ay, float(yaw))
             for sx, sy in _SPOTS
             for ax, ay in _AROUND
             for yaw in range(0, 360, 30)
@@ -107,7 +109,8 @@ def bench_bearings(
         tests = []
         for _ in range(frames):
             x, y = rng.uniform([x0 + 0.3, y0 + 0.3], [x1 - 0.3, y1 - 0.3])
-            image, cam, _, truth = _frame(room, camera, float(x), float(y), rng.uniform(0, 360))
+            yaw = float(rng.uniform(0, 360))
+            image, cam, _, truth = frame_at_pose(room, camera, float(x), float(y), yaw)
             near = np.asarray(truth, np.float64) + rng.uniform(
                 [-0.5, -0.5, -10.0], [0.5, 0.5, 10.0], (poses, 3)
             )
