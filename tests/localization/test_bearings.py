@@ -152,6 +152,19 @@ def test_bad_inputs_are_refused(learned):
         BearingSensor(learn_landmarks(views), colors, outlier=1.0)
     with pytest.raises(ValueError, match="no views"):
         learn_landmarks([])
+    lm, found = sensor.landmarks, views[0].bearings
+    with pytest.raises(ValueError, match="positions must be"):
+        lm.log_likelihood(found, np.zeros((3, 3)), np.zeros(3), 0.01, 0.05)
+    with pytest.raises(ValueError, match="finite"):
+        lm.log_likelihood(found, np.zeros((1, 2)), np.array([np.nan]), 0.01, 0.05)
+    with pytest.raises(ValueError, match="noise_rad"):
+        lm.log_likelihood(found, np.zeros((1, 2)), np.zeros(1), 0.0, 0.05)
+    with pytest.raises(ValueError, match="outlier"):
+        lm.log_likelihood(found, np.zeros((1, 2)), np.zeros(1), 0.01, 1.5)
+    with pytest.raises(ValueError, match="eye_forward_m"):
+        place_turns([LearnedTurn(0.0, 0.0, ())], eye_forward_m=float("inf"))
+    with pytest.raises(ValueError, match="no turns"):
+        place_turns([])
     with pytest.raises(ValueError, match="band_deg"):
         frame_bearings(np.zeros((40, 52, 3), np.uint8), Camera(), colors, band_deg=(5.0, 1.0))
     for band in ((5.0, 1.0), (1.0,), "high", (0.0, float("inf"))):

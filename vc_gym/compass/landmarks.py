@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vc_gym.compass.bearings import FrameBearings
-from vc_gym.validation import MAX_ABS_METRES, int_at_least, positive_float
+from vc_gym.validation import MAX_ABS_METRES, finite_float, int_at_least, positive_float
 
 __all__ = [
     "MAX_CANDIDATES",
@@ -38,12 +38,27 @@ MAX_LANDMARKS = 100_000
 _KEYS = ("positions", "pairs", "std_m", "support")
 
 
+def _check_camera_poses(xy: object, yaw_rad: object) -> tuple[np.ndarray, np.ndarray]:
+    """``(N, 2)`` finite positions and ``(N,)`` finite directions, else a ``ValueError``."""
+    xy_a = np.asarray(xy, dtype=np.float64)
+    yaw_a = np.asarray(yaw_rad, dtype=np.float64)
+    if xy_a.ndim != 2 or xy_a.shape[1] != 2 or yaw_a.shape != (xy_a.shape[0],):
+        raise ValueError(
+            f"positions must be (N, 2) and directions (N,), got {xy_a.shape} and {yaw_a.shape}"
+        )
+    if not (np.all(np.isfinite(xy_a)) and np.all(np.isfinite(yaw_a))):
+        raise ValueError("positions and directions must be finite")
+    return xy_a, yaw_a
+
+
 def eye_positions(
     body_xy: np.ndarray, body_yaw_rad: np.ndarray, eye_forward_m: float
 ) -> np.ndarray:
     """``(N, 2)`` camera positions of bodies at ``body_xy`` (``(N, 2)``, m) heading
     ``body_yaw_rad`` (``(N,)``): the camera sits ``eye_forward_m`` ahead of the body's
     centre, along its heading (a pan turns the camera, not where it is)."""
+    body_xy, body_yaw_rad = _check_camera_poses(body_xy, body_yaw_rad)
+    eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
     return body_xy + eye_forward_m * np.stack([np.cos(body_yaw_rad), np.sin(body_yaw_rad)], 1)
 
 
@@ -129,6 +144,11 @@ class LandmarkMap:
         numpy.ndarray
             ``(N,)`` log-likelihoods; zeros when the frame shows no change.
         """
+        eye_xy, camera_yaw_rad = _check_camera_poses(eye_xy, camera_yaw_rad)
+        noise_rad = positive_float("noise_rad", noise_rad)
+        outlier = positive_float("outlier", outlier)
+        if outlier >= 1.0:
+            raise ValueError(f"outlier must be in (0, 1), got {outlier}")
         total = np.zeros(len(eye_xy))
         if len(bearings) == 0:
             return total
@@ -504,6 +524,7 @@ def place_turns(
     """
     if not turns:
         raise ValueError("no turns to place")
+    eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
     reach = positive_float("search_m", search_m)
     reach_deg = positive_float("search_deg", search_deg)
     int_at_least("rounds", rounds, 1)
