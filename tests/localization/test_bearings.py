@@ -7,75 +7,22 @@ import math
 
 import numpy as np
 import pytest
+from striped_room import HFOV, PALETTE, learned_views, striped_room, true_offsets, view
 
 from vc_gym.compass import Camera
 from vc_gym.compass.bearings import frame_bearings
-from vc_gym.compass.colors import ColorClasses
-from vc_gym.compass.landmarks import LearnedTurn, LearnedView, learn_landmarks, place_turns
+from vc_gym.compass.landmarks import LearnedView, learn_landmarks
 from vc_gym.localization.bearing_sensor import BearingSensor
-from vc_gym.worlds.room import Room, render_room_view
-
-HFOV = 56.9
-PALETTE = np.array(
-    [[200, 40, 40], [40, 160, 60], [40, 70, 200], [230, 210, 60], [150, 60, 170], [240, 240, 235]],
-    np.uint8,
-)
-PX_PER_M = 200
 
 
 @pytest.fixture(scope="module")
 def striped():
-    """A 5 x 4 m room whose walls are vertical stripes of six colours, 0.3-0.9 m wide:
-    its colour changes (the landmarks) lie at known points of the walls."""
-    rng = np.random.default_rng(4)
-    width, depth = 5.0, 4.0
-    perimeter = 2 * (width + depth)
-    edges, s, last = [], 0.0, -1
-    colours = []
-    while s < perimeter - 0.3:
-        c = int(rng.choice([k for k in range(len(PALETTE)) if k != last]))
-        colours.append((s, c))
-        last = c
-        s += rng.uniform(0.3, 0.9)
-        if s < perimeter - 0.3:
-            edges.append(s)
-    tex = np.zeros((120, int(perimeter * PX_PER_M), 3), np.uint8)
-    bounds = [c[0] for c in colours] + [perimeter]
-    for (s0, c), s1 in zip(colours, bounds[1:], strict=True):
-        tex[:, int(round(s0 * PX_PER_M)) : int(round(s1 * PX_PER_M))] = PALETTE[c]
-    room = Room(width, depth, 1.0, tex, floor_rgb=(90, 90, 90), ceiling_rgb=(20, 20, 20))
-    if colours[-1][1] != colours[0][1]:
-        edges.append(0.0)  # where the unrolled walls close, at the corner (W/2, -D/2)
-    # the texture's columns start at pixel edges: an edge at s sits at round(s * px) / px
-    points = np.array([room.wall_point(round(e * PX_PER_M) / PX_PER_M) for e in edges])
-    return room, points
-
-
-def view(room, x, y, yaw):
-    camera = Camera(hfov_deg=HFOV, yaw_deg=yaw)
-    return render_room_view(room, x, y, camera), camera
-
-
-def true_offsets(points, x, y, yaw):
-    ang = np.degrees(np.arctan2(points[:, 1] - y, points[:, 0] - x)) - yaw
-    ang = (ang + 180.0) % 360.0 - 180.0
-    return ang[np.abs(ang) < HFOV / 2 - 1.0]
+    return striped_room()
 
 
 @pytest.fixture(scope="module")
 def learned(striped):
-    """Colour classes and the learning turns: 8 directions at home, the four spots 1 m
-    away and the turns 0.5 m around home."""
-    room, _ = striped
-    positions = [(0, 0), (1, 0), (0, 1), (-1, 0), (0, -1), (0.5, 0), (0, 0.5), (-0.5, 0), (0, -0.5)]
-    yaws = range(0, 360, 45)
-    frames = [(x, y, yaw, *view(room, x, y, yaw)) for x, y in positions for yaw in yaws]
-    colors = ColorClasses.fit([f[3] for f in frames[::4]], n_colors=8, rng=np.random.default_rng(0))
-    views = [
-        LearnedView(frame_bearings(img, cam, colors), float(yaw), float(x), float(y))
-        for x, y, yaw, img, cam in frames
-    ]
-    return colors, views
+    return learned_views(striped)
 
 
 def test_each_colour_edge_is_a_bearing_to_a_fraction_of_a_degree(striped, learned):
@@ -161,10 +108,6 @@ def test_bad_inputs_are_refused(learned):
         lm.log_likelihood(found, np.zeros((1, 2)), np.zeros(1), 0.0, 0.05)
     with pytest.raises(ValueError, match="outlier"):
         lm.log_likelihood(found, np.zeros((1, 2)), np.zeros(1), 0.01, 1.5)
-    with pytest.raises(ValueError, match="eye_forward_m"):
-        place_turns([LearnedTurn(0.0, 0.0, ())], eye_forward_m=float("inf"))
-    with pytest.raises(ValueError, match="no turns"):
-        place_turns([])
     with pytest.raises(ValueError, match="band_deg"):
         frame_bearings(np.zeros((40, 52, 3), np.uint8), Camera(), colors, band_deg=(5.0, 1.0))
     for band in ((5.0, 1.0), (1.0,), "high", (0.0, float("inf"))):
@@ -187,41 +130,6 @@ def test_the_camera_ahead_of_the_body_is_where_the_bearings_are_seen_from(stripe
     assert math.hypot(best[0] - x, best[1] - y) < 0.04, best
     with pytest.raises(ValueError, match="eye_forward_m"):
         BearingSensor(sensor.landmarks, colors, eye_forward_m=float("nan"))
-
-
-def test_turns_whose_believed_poses_drifted_are_placed_anew(striped, learned):
-    """The learning phase walks by odometry: its turns stand up to 0.3 m and 3° from
-    where it believes. Placed against the landmarks of the home turn, they come back to
-    their true poses, and the landmarks of all turns to the true edges."""
-    room, points = striped
-    colors, _ = learned
-    ahead = 0.25
-    rng = np.random.default_rng(5)
-    true = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0), (1.5, 0.5), (-1.5, -0.5)]
-    drift = [(0.0, 0.0, 0.0)] + [
-        (*rng.uniform(-0.3, 0.3, 2), rng.uniform(-3.0, 3.0)) for _ in true[1:]
-    ]
-    turns = []
-    for (x, y), (ex, ey, eyaw) in zip(true, drift, strict=True):
-        frames = []
-        for body in range(0, 360, 45):
-            for pan in (-20.0, 0.0, 20.0):
-                t = math.radians(body)
-                img, cam = view(room, x + ahead * math.cos(t), y + ahead * math.sin(t), body + pan)
-                frames.append((frame_bearings(img, cam, colors), body + eyaw, pan))
-        turns.append(LearnedTurn(x + ex, y + ey, tuple(frames)))
-    landmarks, corrections = place_turns(turns, eye_forward_m=ahead)
-    placed = np.array([(t.x, t.y) for t in turns]) + corrections[:, :2]
-    # measured: every turn within 2 cm (median 0.7 cm), its heading within 0.2 deg
-    np.testing.assert_allclose(placed, true, atol=0.03)
-    np.testing.assert_allclose(corrections[:, 2], [-d[2] for d in drift], atol=0.4)
-    gaps = np.min(np.hypot(*(landmarks.positions[:, None, :] - points[None]).transpose(2, 0, 1)), 1)
-    # measured: 27 of 27 edges, median 1.3 cm off, at most 3.4 cm
-    assert len(landmarks) >= 0.8 * len(points) and np.max(gaps) < 0.05, np.sort(gaps)[-3:]
-    # where the turns were believed to be, the same frames place the edges far worse
-    believed = learn_landmarks([v for t in turns for v in t.views(ahead)])
-    off = np.min(np.hypot(*(believed.positions[:, None, :] - points[None]).transpose(2, 0, 1)), 1)
-    assert np.median(off) > 3 * np.median(gaps)
 
 
 def test_many_rays_are_triangulated_within_bounded_work():

@@ -25,11 +25,9 @@ __all__ = [
     "MAX_CANDIDATES",
     "MAX_LANDMARKS",
     "LandmarkMap",
-    "LearnedTurn",
     "LearnedView",
     "eye_positions",
     "learn_landmarks",
-    "place_turns",
 ]
 
 #: Most landmarks a map file may hold (a room's colour edges number in the hundreds).
@@ -331,7 +329,7 @@ def _fit(o: np.ndarray, a: np.ndarray, floor_rad: float) -> tuple[np.ndarray, fl
         point = np.linalg.lstsq(A, c, rcond=None)[0]
         weights = 1.0 / np.maximum(np.hypot(*(point - o).T), 0.1)
     A = normal * weights[:, None]
-    residual = (A @ point - np.sum(normal * o, axis=1) * weights)  # radians, about
+    residual = A @ point - np.sum(normal * o, axis=1) * weights  # radians, about
     dof = max(len(a) - 2, 1)
     sigma = max(math.sqrt(float(residual @ residual) / dof), floor_rad)
     cov = sigma**2 * np.linalg.pinv(A.T @ A)
@@ -410,150 +408,3 @@ def learn_landmarks(
         np.array([f[3] for f in found], np.int64),
         n_colors,
     )
-
-
-@dataclass(frozen=True)
-class LearnedTurn:
-    """One turn on the spot of the learning phase, as the robot believed it went.
-
-    Attributes
-    ----------
-    x, y : float
-        Where the robot believed its body stood (m).
-    frames : tuple
-        ``(bearings, body_yaw_deg, pan_deg)`` of every frame: its changes, the believed
-        body heading and the head pan.
-    """
-
-    x: float
-    y: float
-    frames: tuple[tuple[FrameBearings, float, float], ...]
-
-    def views(
-        self, eye_forward_m: float, correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    ) -> list[LearnedView]:
-        """The frames as views from the camera, the turn moved by ``correction``
-        ``(dx m, dy m, dyaw deg)``; the camera sits ``eye_forward_m`` ahead of the body."""
-        dx, dy, dyaw = correction
-        yaws = np.array([yaw + dyaw for _, yaw, _ in self.frames], np.float64)
-        body = np.broadcast_to([self.x + dx, self.y + dy], (len(yaws), 2))
-        eyes = eye_positions(body, np.radians(yaws), eye_forward_m)
-        return [
-            LearnedView(found, yaw + pan, float(ex), float(ey))
-            for (found, _, pan), yaw, (ex, ey) in zip(self.frames, yaws, eyes, strict=True)
-        ]
-
-
-def _turn_scores(
-    landmarks: LandmarkMap,
-    turn: LearnedTurn,
-    hypotheses: np.ndarray,
-    eye_forward_m: float,
-    noise_rad: float,
-    outlier: float,
-) -> np.ndarray:
-    """Log-likelihood of every ``(dx, dy, dyaw deg)`` correction of ``turn``: the sum
-    over its frames of :meth:`LandmarkMap.log_likelihood`."""
-    total = np.zeros(len(hypotheses))
-    body = np.array([turn.x, turn.y]) + hypotheses[:, :2]
-    for found, yaw, pan in turn.frames:
-        t = np.radians(yaw + hypotheses[:, 2])
-        eye = eye_positions(body, t, eye_forward_m)
-        total += landmarks.log_likelihood(found, eye, t + math.radians(pan), noise_rad, outlier)
-    return total
-
-
-def _spread(n: int, most: int) -> np.ndarray:
-    """At most ``most`` of ``range(n)``, evenly spread."""
-    if n == 0:
-        return np.zeros(0, int)
-    return np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
-
-
-def _grid(centre: np.ndarray, reach_m: float, step_m: float, reach_deg: float, step_deg: float):
-    xy = np.arange(-reach_m, reach_m + 1e-9, step_m)
-    yaw = np.arange(-reach_deg, reach_deg + 1e-9, step_deg)
-    gx, gy, gt = np.meshgrid(xy, xy, yaw, indexing="ij")
-    return centre + np.stack([gx.ravel(), gy.ravel(), gt.ravel()], axis=1)
-
-
-def place_turns(
-    turns: list[LearnedTurn],
-    eye_forward_m: float = 0.0,
-    search_m: float = 0.5,
-    search_deg: float = 6.0,
-    rounds: int = 2,
-    noise_deg: float = 0.3,
-    outlier: float = 0.05,
-    max_frames: int = 24,
-) -> tuple[LandmarkMap, np.ndarray]:
-    """Landmarks from turns whose believed poses drifted, with each turn placed anew.
-
-    The first turn (home, where the robot starts: the frame of the map) is taken as
-    believed. Its frames alone place the first landmarks (the camera, ahead of the body,
-    circles as the body turns, which gives the rays a baseline). Every other turn is
-    then placed where its frames' changes fit those landmarks best: a search of body
-    shifts within ``search_m`` and heading offsets within ``search_deg`` (5 cm and 1°
-    steps, then 1 cm and 0.25° around the best), the likelihood of
-    :meth:`LandmarkMap.log_likelihood`. The landmarks are then learned from every turn
-    at its corrected pose, and the turns placed again against them (``rounds`` times in
-    all; later rounds search within a fifth of the reach).
-
-    Parameters
-    ----------
-    turns : list of LearnedTurn
-        Home first.
-    eye_forward_m : float
-        How far ahead of the body's centre the camera sits.
-    search_m, search_deg : float
-        How far a turn's believed position and heading may be off.
-    rounds : int
-        Placements of the turns against the landmarks (at least 1).
-    noise_deg, outlier : float
-        The likelihood's bearing noise and outlier floor.
-    max_frames : int
-        Frames of a turn (evenly spread over it) its placement is scored on; the
-        landmarks are learned from every frame.
-
-    Returns
-    -------
-    landmarks : LandmarkMap
-        From every turn at its corrected pose.
-    corrections : numpy.ndarray
-        ``(len(turns), 3)``: ``(dx m, dy m, dyaw deg)`` of each turn (zeros for home).
-    """
-    if not turns:
-        raise ValueError("no turns to place")
-    eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
-    reach = positive_float("search_m", search_m)
-    reach_deg = positive_float("search_deg", search_deg)
-    int_at_least("rounds", rounds, 1)
-    noise = math.radians(positive_float("noise_deg", noise_deg))
-    int_at_least("max_frames", max_frames, 1)
-    scored = [
-        LearnedTurn(t.x, t.y, tuple(t.frames[i] for i in _spread(len(t.frames), max_frames)))
-        for t in turns
-    ]
-    corrections = np.zeros((len(turns), 3))
-    # home alone: each edge is seen from two or three camera positions a few decimetres
-    # apart (rough, but enough to place the other turns near their truth)
-    landmarks = learn_landmarks(turns[0].views(eye_forward_m), min_positions=2)
-    for r in range(rounds):
-        scale = 1.0 if r == 0 else 0.2
-        for k in range(1, len(turns)):
-            coarse = _grid(
-                corrections[k], reach * scale, 0.05 * scale, reach_deg * scale, 1.0 * scale
-            )
-            ll = _turn_scores(landmarks, scored[k], coarse, eye_forward_m, noise, outlier)
-            fine = _grid(
-                coarse[np.argmax(ll)], 0.05 * scale, 0.01 * scale, 1.0 * scale, 0.25 * scale
-            )
-            ll = _turn_scores(landmarks, scored[k], fine, eye_forward_m, noise, outlier)
-            corrections[k] = fine[np.argmax(ll)]
-        views = [
-            v
-            for turn, c in zip(turns, corrections, strict=True)
-            for v in turn.views(eye_forward_m, (float(c[0]), float(c[1]), float(c[2])))
-        ]
-        landmarks = learn_landmarks(views)
-    return landmarks, corrections
