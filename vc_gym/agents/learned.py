@@ -77,6 +77,7 @@ CONFIG_ENV_KEYS = (
     "position_std",
     "normalise_at",
     "around_m",
+    "landmarks",
 )
 
 #: ``vc_gym/Homing-v0`` arguments that choose the place a run trained in. An evaluation

@@ -399,8 +399,8 @@ def place_turns(
     believed. Its frames alone place the first landmarks (the camera, ahead of the body,
     circles as the body turns, which gives the rays a baseline). Every other turn is
     then placed where its frames' changes fit those landmarks best: a search of body
-    shifts within ``search_m`` and first headings within ``search_deg`` (5 cm and 1°
-    steps, then 1 cm and 0.25° around the best), the likelihood of
+    shifts within ``search_m`` and first headings within ``search_deg`` (10 cm and 2°
+    steps, then 2 cm and 0.4°, then 1 cm and 0.2° around the best), the likelihood of
     :meth:`LandmarkMap.log_likelihood`. With ``adjust``, every turn (with its turn
     scale) and landmark is then adjusted together (:func:`adjust_turns`). The landmarks
     are learned from every turn at its corrected pose.
@@ -445,11 +445,13 @@ def place_turns(
         scored = LearnedTurn(
             t.x, t.y, tuple(t.frames[i] for i in _spread(len(t.frames), max_frames))
         )
-        coarse = _grid(corrections[k], (reach, reach_deg, 0.0), (0.05, 1.0, 0.0))
-        ll = _turn_scores(landmarks, scored, coarse, eye_forward_m, noise, outlier)
-        fine = _grid(coarse[np.argmax(ll)], (0.05, 1.0, 0.0), (0.01, 0.25, 0.0))
-        ll = _turn_scores(landmarks, scored, fine, eye_forward_m, noise, outlier)
-        corrections[k] = fine[np.argmax(ll)]
+        best = corrections[k]
+        for reach_k, step in ((reach, 0.1), (0.1, 0.02), (0.02, 0.01)):
+            deg = reach_deg if step == 0.1 else 20.0 * reach_k
+            grid = _grid(best, (reach_k, deg, 0.0), (step, 20.0 * step, 0.0))
+            ll = _turn_scores(landmarks, scored, grid, eye_forward_m, noise, outlier)
+            best = grid[np.argmax(ll)]
+        corrections[k] = best
     if adjust:
         first = learn_landmarks(_views(turns, corrections, eye_forward_m))
         corrections, _ = adjust_turns(turns, first, corrections, eye_forward_m, noise_deg=noise_deg)

@@ -117,7 +117,7 @@ def homing_mode(mode: str) -> HomingMode:
 LEARNED_AGENT_MODE = "pose-home"
 #: The task's own values of the settings a mode may change (what a task argument
 #: left out means).
-_TASK_LEARNING_DEFAULTS = {"normalise_at": "return", "around_m": 0.0}
+_TASK_LEARNING_DEFAULTS = {"normalise_at": "return", "around_m": 0.0, "landmarks": False}
 
 
 def mode_of_task(task_kwargs: Mapping[str, Any]) -> str | None:

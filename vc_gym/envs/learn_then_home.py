@@ -35,6 +35,7 @@ from vc_gym.validation import (
     MAX_LEARNING_PHASE_S,
     check_action,
     check_reset_options,
+    flag,
     int_at_least,
     nonnegative_float,
     positive_float,
@@ -152,7 +153,9 @@ class LearnThenHomeEnv(gym.Env):
     then lose the offset of the walk back's odometry drift). ``around_m > 0`` also
     learns turns ``around_m`` around home and every spot, kept as atlas entries of their
     own (:class:`~vc_gym.envs.learning.LearningConfig`; the atlas then has 25 entries):
-    the input of the ``pose`` tracker. ``learning_seed`` seeds the
+    the input of the ``pose`` tracker. ``landmarks=True`` also places the colour changes
+    the learned turns saw in the room (the atlas' ``landmarks``), the input of a bearing
+    tracker. ``learning_seed`` seeds the
     room for the learning phase on its own (default: drawn from the reset seed), so that
     envs reset with different seeds learn the same place the same way.
     ``atlas_file="place.npz"`` keeps the learning phase's atlas in that file: the first
@@ -203,6 +206,7 @@ class LearnThenHomeEnv(gym.Env):
         learner: Learner | None = None,
         normalise_at: str = "return",
         around_m: float = 0.0,
+        landmarks: bool = False,
         learning_seed: int | None = None,
         atlas_file: str | os.PathLike | None = None,
         place_cache: bool | str | os.PathLike | PlaceCache | None = True,
@@ -248,6 +252,8 @@ class LearnThenHomeEnv(gym.Env):
             int_at_least("learning_seed", learning_seed, 0)
         if around_m and learning != "scripted":
             raise ValueError("around_m needs learning='scripted' (the agent learns its own)")
+        if flag("landmarks", landmarks) and learning != "scripted":
+            raise ValueError("landmarks needs learning='scripted' (the agent learns its own)")
         if atlas_file is not None and learning != "scripted":
             raise ValueError("atlas_file needs learning='scripted' (the agent learns its own)")
         if atlas_file is not None and room_kwargs.get("randomize"):
@@ -269,6 +275,7 @@ class LearnThenHomeEnv(gym.Env):
             compass=compass if compass is not None else CompassConfig(),
             normalise_at=normalise_at,
             around_m=nonnegative_float("around_m", around_m),
+            landmarks=bool(landmarks),
         )
         self.room = AiboRoomEnv(render_mode=render_mode, **room_kwargs)
         self.render_mode = render_mode

@@ -26,8 +26,11 @@ from tqdm import tqdm
 
 from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
+from vc_gym.compass.bearings import frame_bearings
+from vc_gym.compass.turn_placement import LearnedTurn, place_turns
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import compose
+from vc_gym.sim.robot import EYE_OFFSET_M
 from vc_gym.validation import (
     MAX_HALF_LIFE_S,
     MAX_LEARN_TIME_S,
@@ -120,6 +123,13 @@ class LearningConfig:
         tracker needs to re-draw a spot's map for a nearby position
         (:class:`~vc_gym.compass.pose_maps.PoseMaps`). Default 0: the paper's four
         spots. At most half of ``spot_distance_m``.
+    landmarks : bool
+        Beyond the paper: keep every learned turn's colour changes at their bearings
+        (:func:`~vc_gym.compass.bearings.frame_bearings`), place the turns anew where
+        their changes agree (:func:`~vc_gym.compass.turn_placement.place_turns`) and
+        keep the changes' positions as the atlas' ``landmarks``
+        (:class:`~vc_gym.compass.landmarks.LandmarkMap`), what a bearing tracker
+        measures against. Default ``False``.
     """
 
     spot_distance_m: float = 1.0
@@ -130,12 +140,14 @@ class LearningConfig:
     half_life_s: float = 0.3
     compass: CompassConfig = field(default_factory=CompassConfig)
     around_m: float = 0.0
+    landmarks: bool = False
 
     def __post_init__(self) -> None:
         positive_float("spot_distance_m", self.spot_distance_m)
         positive_float_at_most("learn_time_s", self.learn_time_s, MAX_LEARN_TIME_S, "seconds")
         positive_float_at_most("half_life_s", self.half_life_s, MAX_HALF_LIFE_S, "seconds")
         nonnegative_float("around_m", self.around_m)
+        flag("landmarks", self.landmarks)
         if self.around_m > 0.5 * self.spot_distance_m:
             raise ValueError(
                 f"around_m must be at most half of spot_distance_m ({self.spot_distance_m:g} m)"
@@ -157,10 +169,12 @@ class LearningConfig:
 
     def to_key(self) -> dict:
         """The fields as plain data, identifying a learned place (atlas files, the place
-        cache); ``around_m`` only when set, so the paper's places keep their keys."""
+        cache); ``around_m`` and ``landmarks`` only when set, so the places learned
+        without them keep their keys."""
         out = asdict(self)
-        if not self.around_m:
-            del out["around_m"]
+        for name in ("around_m", "landmarks"):
+            if not out[name]:
+                del out[name]
         return out
 
 
@@ -178,12 +192,21 @@ class LearningResult:
         True ``(x, y, yaw)`` of every spot-learning frame (for plots only).
     odometry_turn_scale : float
         The loop-closure correction of the odometry's turns (1: none).
+    turn_corrections : numpy.ndarray or None
+        With ``LearningConfig(landmarks=True)``: ``(turns, 4)`` how each learned turn
+        (home first, then in the order learned) was placed anew, a
+        :data:`~vc_gym.compass.turn_placement.Correction` of where it was believed.
+    turns : list of LearnedTurn
+        With ``LearningConfig(landmarks=True)``: the learned turns as believed (home
+        first), their frames' colour changes at the odometry's headings.
     """
 
     atlas: CompassAtlas
     spots: dict[str, tuple[float, float]]
     true_path: list[tuple[float, float, float]] = field(default_factory=list)
     odometry_turn_scale: float = 1.0
+    turn_corrections: np.ndarray | None = None
+    turns: list[LearnedTurn] = field(default_factory=list)
 
 
 #: A learner: ``learner(room, config) -> LearningResult``. ``room`` is a
@@ -244,6 +267,9 @@ class ScriptedLearner:
         self.unreached = 0
         #: true ``(x, y, yaw)`` of every frame of the last :meth:`learn_turn` (plots only)
         self.turn_path: list[tuple[float, float, float]] = []
+        #: with ``config.landmarks``: every turn learned, its frames' colour changes at
+        #: the body headings the odometry counted (home first)
+        self.turns: list[LearnedTurn] = []
 
     def _act(self, forward: float = 0.0, turn: float = 0.0, pan: float = 0.0) -> None:
         self.steps_taken += 1
@@ -425,13 +451,18 @@ class ScriptedLearner:
                 UserWarning,
                 stacklevel=2,
             )
+        corrections = None
+        if cfg.landmarks:
+            atlas.landmarks, corrections = place_turns(self.turns, eye_forward_m=EYE_OFFSET_M[0])
         learned = {name: place for name, (place, _) in compasses.items()}
-        return LearningResult(atlas, learned, path, self.rot_scale)
+        return LearningResult(atlas, learned, path, self.rot_scale, corrections, list(self.turns))
 
     def _learn_here(self, colors: ColorClasses, steps: int, path: list, bar: tqdm) -> VisualCompass:
         """The map of where the robot stands: 8 × 45° by its belief, ``steps`` frames
         each with head scanning (4.3)."""
         vc = VisualCompass(self.config.compass, colors)
+        frames = []  # with landmarks: (changes, body heading by odometry, head pan)
+        start = None  # the belief and the odometry's count at the turn's first frame
         for k in range(8):
             self._turn_to(45.0 * k)
             for _ in range(steps):
@@ -439,7 +470,17 @@ class ScriptedLearner:
                 pan = float(self.obs["head"][0])
                 vc.learn(self.obs["image"], self.camera.replace(yaw_deg=self.belief[2] + pan))
                 path.append(tuple(float(v) for v in self.info["pose"]))
+                if self.config.landmarks:
+                    if start is None:
+                        start = (*self.belief, self.turn_accum)
+                    # the heading belief follows the home map, whose parallax bends it
+                    # away from home; the odometry counts the turn itself well
+                    yaw = start[2] + self.turn_accum - start[3]
+                    changes = frame_bearings(self.obs["image"], self.camera, colors)
+                    frames.append((changes, float(yaw), pan))
                 bar.update()
+        if frames:
+            self.turns.append(LearnedTurn(float(start[0]), float(start[1]), tuple(frames)))
         return vc
 
     def _learn_around(
@@ -476,7 +517,7 @@ class ScriptedLearner:
         cfg = self.config
         self.turn_accum = 0.0
         self.turn_path = []
-        start = float(self.belief[2])
+        x0, y0, start = (float(v) for v in self.belief)
         frames = []  # (image, believed body turn since the start, head pan, direction)
         for k in range(8):
             self._turn_to(start + 45.0 * k)
@@ -506,6 +547,21 @@ class ScriptedLearner:
         for image, turn, pan, _ in frames:
             home.learn(image, self.camera.replace(yaw_deg=start + turn * self.rot_scale + pan))
         self.home_compass = home
+        if cfg.landmarks:
+            self.turns = [
+                LearnedTurn(
+                    x0,
+                    y0,
+                    tuple(
+                        (
+                            frame_bearings(image, self.camera, colors),
+                            start + turn * self.rot_scale,
+                            pan,
+                        )
+                        for image, turn, pan, _ in frames
+                    ),
+                )
+            ]
         self.belief[2] = wrap360(start + actual)
         self.learn_filter = HeadingGridFilter(
             rule="mixing", half_life_s=cfg.half_life_s, dt_s=self.dt

@@ -35,7 +35,7 @@ LEARNERS = ("scripted", "spot", "grid")
 
 
 #: The learning options of ``vc_gym/LearnThenHome-v0`` an atlas spec may set.
-LEARNING_OPTIONS = ("normalise_at", "around_m")
+LEARNING_OPTIONS = ("normalise_at", "around_m", "landmarks")
 
 
 def atlas_spec(
