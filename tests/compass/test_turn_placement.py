@@ -58,13 +58,13 @@ def test_turns_whose_believed_poses_drifted_are_placed_anew(drifted):
     points, turns, errors = drifted
     landmarks, corrections = place_turns(turns, eye_forward_m=AHEAD)
     placed = np.array([(t.x, t.y) for t in turns]) + corrections[:, :2]
-    np.testing.assert_allclose(corrections[0], NO_CORRECTION)
-    # measured: every turn within 0.2 cm, its heading within 0.05 deg, its scale 0.04 %
+    np.testing.assert_array_equal(corrections[0, :3], 0.0)  # home is the map's frame
+    # measured: every turn within 0.3 cm, its heading within 0.05 deg, its scale 0.03 %
     np.testing.assert_allclose(placed, TRUE, atol=0.02)
     np.testing.assert_allclose(corrections[:, 2], -errors[:, 2], atol=0.3)
     np.testing.assert_allclose(corrections[:, 3] * errors[:, 3], 1.0, atol=0.003)
     gaps = _gaps(landmarks.positions, points)
-    # measured: 27 of 27 edges, median 0.3 cm off, at most 1.3 cm
+    # measured: 27 of 27 edges, median 0.4 cm off, at most 1.5 cm
     assert len(landmarks) >= 0.8 * len(points) and np.max(gaps) < 0.03, np.sort(gaps)[-3:]
     # where the turns were believed to be, the same frames place the edges far worse
     believed = learn_landmarks([v for t in turns for v in t.views(AHEAD)])
@@ -86,8 +86,8 @@ def test_the_adjustment_alone_beats_the_grid_search(drifted):
     after = np.hypot(*(adjusted[1:, :2] - truth[1:]).T)
     assert np.median(after) < 0.5 * np.median(before), (before, after)
     assert positions.shape == landmarks.positions.shape
-    # the home turn is the map's frame: it never moves
-    np.testing.assert_array_equal(adjusted[0], NO_CORRECTION)
+    # the home turn is the map's frame: it never moves (only its turn scale may change)
+    np.testing.assert_array_equal(adjusted[0, :3], 0.0)
 
 
 def test_bad_input_is_refused(drifted):

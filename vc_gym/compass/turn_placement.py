@@ -34,6 +34,17 @@ __all__ = [
 Correction = tuple[float, float, float, float]
 #: The correction that leaves a turn as believed.
 NO_CORRECTION: Correction = (0.0, 0.0, 0.0, 1.0)
+#: Spread of the odometry's count of a walk between turns: ``WALK_SIGMA_M`` plus
+#: ``WALK_SIGMA_SHARE`` of its length, and ``WALK_SIGMA_DEG`` plus ``WALK_SIGMA_TURN_SHARE``
+#: of its turn.
+WALK_SIGMA_M = 0.03
+WALK_SIGMA_SHARE = 0.05
+WALK_SIGMA_DEG = 1.5
+WALK_SIGMA_TURN_SHARE = 0.03
+#: Prior spread of the gain the odometry's lengths are off by (the same for every walk).
+WALK_GAIN_SIGMA = 0.1
+#: How stiffly the first turn's position (m) and first heading (rad) are held.
+_PIN = 1e-5
 #: Most landmarks :func:`adjust_turns` moves (the best observed; the rest stay where they
 #: are and their changes are left out): bounds its normal equations.
 MAX_ADJUSTED_LANDMARKS = 2000
@@ -52,11 +63,16 @@ class LearnedTurn:
         body heading and the head pan. The headings run on without wrapping (a full turn
         ends near 360° from where it began), as the odometry counts them: a correction
         scales the turn since the first frame.
+    walk : tuple of float, optional
+        ``(forward m, left m, turn deg)``: how far the odometry says the body moved from
+        the previous turn's last frame to this turn's first, in the body's frame at that
+        last frame. It ties the turns in a chain (``None``: placed on its own).
     """
 
     x: float
     y: float
     frames: tuple[tuple[FrameBearings, float, float], ...]
+    walk: tuple[float, float, float] | None = None
 
     def body_yaws(self, correction: Correction = NO_CORRECTION) -> np.ndarray:
         """``(len(frames),)`` body headings (deg) under ``correction``
@@ -67,6 +83,14 @@ class LearnedTurn:
         if yaws.size == 0:
             return yaws
         return yaws[0] + dyaw + (yaws - yaws[0]) * scale
+
+    def last_pose(self, correction: Correction = NO_CORRECTION) -> tuple[float, float, float]:
+        """``(x m, y m, heading deg)`` of the body at the last frame, corrected."""
+        return (
+            self.x + correction[0],
+            self.y + correction[1],
+            float(self.body_yaws(correction)[-1]),
+        )
 
     def views(
         self, eye_forward_m: float, correction: Correction = NO_CORRECTION
@@ -121,8 +145,11 @@ def _grid(
     """Corrections on a grid around ``centre`` ``(dx, dy, dyaw, turn scale)``:
     ``reach`` and ``step`` give the position (m), heading (deg) and turn scale's
     half-widths and steps (a step of 0 keeps the centre's value)."""
+    # symmetric about the centre, which is always a node
     axes = [
-        np.arange(-r, r + 1e-9, st) if st > 0 else np.zeros(1)
+        np.arange(-math.floor(r / st + 1e-9), math.floor(r / st + 1e-9) + 1) * st
+        if st > 0
+        else np.zeros(1)
         for r, st in zip(reach, step, strict=True)
     ]
     ax, ay, ayaw, ascale = np.meshgrid(axes[0], axes[0], axes[1], axes[2], indexing="ij")
@@ -132,6 +159,92 @@ def _grid(
 
 def _wrap(a: np.ndarray) -> np.ndarray:
     return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def _walk_sigmas(walk: tuple[float, float, float]) -> tuple[float, float]:
+    """σ of a walk's end position (m) and heading (deg)."""
+    return (
+        WALK_SIGMA_M + WALK_SIGMA_SHARE * math.hypot(walk[0], walk[1]),
+        WALK_SIGMA_DEG + WALK_SIGMA_TURN_SHARE * abs(walk[2]),
+    )
+
+
+def _chained(
+    previous: LearnedTurn, correction: np.ndarray, walk: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """Where the odometry's ``walk`` puts the body, from ``previous``'s last frame."""
+    x, y, yaw = previous.last_pose(tuple(float(e) for e in correction))
+    t = math.radians(yaw)
+    return (
+        x + walk[0] * math.cos(t) - walk[1] * math.sin(t),
+        y + walk[0] * math.sin(t) + walk[1] * math.cos(t),
+        yaw + walk[2],
+    )
+
+
+@dataclass(frozen=True)
+class _Walks:
+    """The walks that chain a turn to the one before it (radians)."""
+
+    turn: np.ndarray  # (W,) the turn the walk ends at (>= 1)
+    prev_first: np.ndarray  # (W,) the previous turn's first believed heading
+    prev_rel: np.ndarray  # (W,) its last frame's turn since then
+    first: np.ndarray  # (W,) the turn's first believed heading
+    walk: np.ndarray  # (W, 3) forward, left (m), turn (rad)
+    sigma: np.ndarray  # (W, 2) position (m), heading (rad)
+
+    @classmethod
+    def of(cls, turns: list[LearnedTurn]) -> _Walks:
+        rows = []
+        for k in range(1, len(turns)):
+            t, prev = turns[k], turns[k - 1]
+            if t.walk is None or not t.frames or not prev.frames:
+                continue
+            s_m, s_deg = _walk_sigmas(t.walk)
+            rows.append(
+                (k, prev.frames[0][1], prev.frames[-1][1] - prev.frames[0][1], t.frames[0][1],
+                 t.walk[0], t.walk[1], t.walk[2], s_m, s_deg)
+            )  # fmt: skip
+        a = np.array(rows, np.float64).reshape(-1, 9)
+        rad = np.radians
+        return cls(
+            a[:, 0].astype(np.int64), rad(a[:, 1]), rad(a[:, 2]), rad(a[:, 3]),
+            np.stack([a[:, 4], a[:, 5], rad(a[:, 6])], axis=1),
+            np.stack([a[:, 7], rad(a[:, 8])], axis=1),
+        )  # fmt: skip
+
+    def residuals(
+        self, where: np.ndarray, cor: np.ndarray, gain: float, n: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Residuals ``(3W,)`` (in σ) of where each walk, its length times ``gain``,
+        ends against its turn's first frame, and their dense Jacobian ``(3W, n)`` over
+        :func:`_levenberg_marquardt`'s parameters (headings in radians; the gain last)."""
+        w_n = len(self.turn)
+        r = np.zeros(3 * w_n)
+        jac = np.zeros((3 * w_n, n))
+        for i, k in enumerate(self.turn):
+            p = k - 1
+            psi = self.prev_first[i] + cor[p, 2] + self.prev_rel[i] * cor[p, 3]
+            c, s = math.cos(psi), math.sin(psi)
+            fx, fy, fyaw = self.walk[i]
+            sp, sy = self.sigma[i]
+            along = np.array([c * fx - s * fy, s * fx + c * fy])
+            end = where[p] + cor[p, :2] + gain * along
+            jac[3 * i : 3 * i + 2, n - 1] = along / sp
+            fx, fy = gain * fx, gain * fy
+            r[3 * i : 3 * i + 2] = (end - where[k] - cor[k, :2]) / sp
+            r[3 * i + 2] = _wrap(psi + fyaw - self.first[i] - cor[k, 2]) / sy
+            turn_cols = 4 * k
+            jac[3 * i, turn_cols] = jac[3 * i + 1, turn_cols + 1] = -1.0 / sp
+            jac[3 * i + 2, turn_cols + 2] = -1.0 / sy
+            d_psi = np.array([-s * fx - c * fy, c * fx - s * fy]) / sp
+            prev_cols = 4 * p
+            jac[3 * i, prev_cols] = jac[3 * i + 1, prev_cols + 1] = 1.0 / sp
+            jac[3 * i : 3 * i + 2, prev_cols + 2] = d_psi
+            jac[3 * i : 3 * i + 2, prev_cols + 3] = d_psi * self.prev_rel[i]
+            jac[3 * i + 2, prev_cols + 2] = 1.0 / sy
+            jac[3 * i + 2, prev_cols + 3] = self.prev_rel[i] / sy
+        return r, jac
 
 
 @dataclass(frozen=True)
@@ -238,10 +351,14 @@ def adjust_turns(
 
     Every change of every frame is matched to the landmark of its colour pair whose
     predicted bearing is nearest within ``gate_deg``; then the corrections of every turn
-    but the first (home: the map's frame) and the positions of the matched landmarks
-    minimise the Huber cost (3σ) of the bearing residuals, ``observed - predicted`` over
-    ``noise_deg``, with a Gaussian prior of ``scale_sigma`` on each turn scale around 1,
-    by Levenberg-Marquardt on the normal equations. The matching is redone
+    (of the first, home, only its turn scale: its position and first heading are the
+    map's frame) and the positions of the matched landmarks minimise the Huber cost (3σ)
+    of the bearing residuals, ``observed - predicted`` over
+    ``noise_deg``, with a Gaussian prior of ``scale_sigma`` on each turn scale around 1
+    and, for a turn with a ``walk``, a Gaussian of the walk's spread on where that walk
+    from the turn before ends (its length times one gain for all walks, itself adjusted
+    with a prior of :data:`WALK_GAIN_SIGMA`: the odometry counts lengths a few per cent
+    off), by Levenberg-Marquardt on the normal equations. The matching is redone
     ``associations`` times.
 
     Parameters
@@ -266,7 +383,7 @@ def adjust_turns(
     Returns
     -------
     corrections : numpy.ndarray
-        ``(len(turns), 4)``, the first turn's unchanged.
+        ``(len(turns), 4)``; the first turn's position and heading unchanged.
     positions : numpy.ndarray
         ``(len(landmarks), 2)`` the landmarks' adjusted positions (those never matched,
         or beyond :data:`MAX_ADJUSTED_LANDMARKS`, where they were).
@@ -287,6 +404,8 @@ def adjust_turns(
     if len(changes.pair) == 0 or len(positions) == 0 or len(turns) < 2:
         return cor, positions
     where = np.array([(t.x, t.y) for t in turns], np.float64)
+    walks = _Walks.of(turns)
+    walk_gain = 1.0
     cor[:, 2] = np.radians(cor[:, 2])
     hfov = next(f[0].hfov_deg for t in turns for f in t.frames)
     half_fov = math.radians(hfov) / 2.0
@@ -303,10 +422,12 @@ def adjust_turns(
             break
         c = changes.subset(keep)
         lm = slot[match[keep]]
-        cor, positions[moved] = _levenberg_marquardt(
-            where, cor, positions[moved], c, lm, eye_forward_m, noise, scale_sigma, max_steps
-        )
+        cor, positions[moved], walk_gain = _levenberg_marquardt(
+            where, cor, positions[moved], walk_gain, c, lm, walks, eye_forward_m, noise,
+            scale_sigma, max_steps,
+        )  # fmt: skip
     cor[:, 2] = np.degrees(cor[:, 2])
+    cor[0, :3] = corrections[0][:3]  # held by the stiff prior; exactly as given
     return cor, positions
 
 
@@ -314,19 +435,23 @@ def _levenberg_marquardt(
     where: np.ndarray,
     cor: np.ndarray,
     points: np.ndarray,
+    walk_gain: float,
     c: _Changes,
     lm: np.ndarray,
+    walks: _Walks,
     eye_forward_m: float,
     noise: float,
     scale_sigma: float,
     max_steps: int,
-) -> tuple[np.ndarray, np.ndarray]:
-    """The steps of :func:`adjust_turns` for one matching: parameters are the turns'
-    corrections but the first (4 each, heading in radians) then the points (2 each)."""
-    n_turns = len(cor) - 1
-    n_turn, n = 4 * n_turns, 4 * n_turns + 2 * len(points)
-    # the columns each residual touches; the first turn's go to a dummy column n
-    t_cols = np.where(c.turn[:, None] > 0, 4 * (c.turn[:, None] - 1) + np.arange(4), n)
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """The steps of :func:`adjust_turns` for one matching. The parameters are the turns'
+    corrections (4 each, heading in radians; the first turn's position and heading held
+    by a stiff prior, :data:`_PIN`: the map's frame), the points (2 each) and the gain
+    of the odometry's walk lengths."""
+    n_turns = len(cor)
+    n_turn, n = 4 * n_turns, 4 * n_turns + 2 * len(points) + 1
+    # the columns each residual touches (n: a dummy column, never used)
+    t_cols = 4 * c.turn[:, None] + np.arange(4)
     cols = np.concatenate([t_cols, n_turn + 2 * lm[:, None] + np.arange(2)], axis=1)
     scale_cols = 4 * np.arange(n_turns) + 3
 
@@ -336,21 +461,31 @@ def _levenberg_marquardt(
         q = np.maximum(np.sum(d**2, axis=1), 1e-4)
         r = _wrap(c.offset - np.arctan2(d[:, 1], d[:, 0]) + cam) / noise
         d_yaw = 1.0 + eye_forward_m * (d[:, 0] * np.cos(body_yaw) + d[:, 1] * np.sin(body_yaw)) / q
-        jac = (
-            np.stack(
-                [-d[:, 1] / q, d[:, 0] / q, d_yaw, c.rel * d_yaw, d[:, 1] / q, -d[:, 0] / q], axis=1
-            )
-            / noise
+        jac = np.stack(
+            [-d[:, 1] / q, d[:, 0] / q, d_yaw, c.rel * d_yaw, d[:, 1] / q, -d[:, 0] / q], axis=1
         )
-        return r, jac
+        return r, jac / noise
 
-    def total_cost(cr: np.ndarray, pts: np.ndarray) -> float:
-        r, _ = residuals(cr, pts)
-        prior = (cr[1:, 3] - 1.0) / scale_sigma
-        return _huber(r, 3.0)[0] + 0.5 * float(prior @ prior)
+    def priors(cr: np.ndarray, gain: float) -> np.ndarray:
+        return np.concatenate(
+            [(cr[:, 3] - 1.0) / scale_sigma, cr[0, :3] / _PIN, [(gain - 1.0) / WALK_GAIN_SIGMA]]
+        )
 
+    def total_cost(cr: np.ndarray, pts: np.ndarray, gain: float) -> float:
+        chain = walks.residuals(where, cr, gain, n)[0]
+        prior = priors(cr, gain)
+        return (
+            _huber(residuals(cr, pts)[0], 3.0)[0]
+            + 0.5 * float(prior @ prior)
+            + 0.5 * float(chain @ chain)
+        )
+
+    prior_cols = np.concatenate([scale_cols, [0, 1, 2], [n - 1]])
+    prior_w = np.concatenate(
+        [np.full(n_turns, 1.0 / scale_sigma), np.full(3, 1.0 / _PIN), [1.0 / WALK_GAIN_SIGMA]]
+    )
     damping = 1e-3
-    cost = total_cost(cor, points)
+    cost = total_cost(cor, points, walk_gain)
     for _ in range(max_steps):
         r, jac = residuals(cor, points)
         _, w = _huber(r, 3.0)
@@ -359,16 +494,19 @@ def _levenberg_marquardt(
         h = np.bincount(flat, outer, minlength=(n + 1) ** 2).reshape(n + 1, n + 1)[:n, :n]
         g = np.bincount(cols.ravel(), (w[:, None] * r[:, None] * jac).ravel(), minlength=n + 1)
         h, g = h.copy(), g[:n].copy()
-        h[scale_cols, scale_cols] += 1.0 / scale_sigma**2
-        g[scale_cols] += (cor[1:, 3] - 1.0) / scale_sigma**2
+        h[prior_cols, prior_cols] += prior_w**2
+        g[prior_cols] += priors(cor, walk_gain) * prior_w
+        chain, chain_jac = walks.residuals(where, cor, walk_gain, n)
+        h += chain_jac.T @ chain_jac
+        g += chain_jac.T @ chain
         accepted = False
         while damping < 1e8:
             a = h + damping * np.diag(np.diag(h) + 1e-9)
             step = np.linalg.solve(a, -g)
-            new_cor = cor.copy()
-            new_cor[1:] += step[:n_turn].reshape(-1, 4)
-            new_points = points + step[n_turn:].reshape(-1, 2)
-            new_cost = total_cost(new_cor, new_points)
+            new_cor = cor + step[:n_turn].reshape(-1, 4)
+            new_points = points + step[n_turn:-1].reshape(-1, 2)
+            new_gain = walk_gain + float(step[-1])
+            new_cost = total_cost(new_cor, new_points, new_gain)
             if new_cost < cost:
                 accepted = True
                 damping = max(damping / 3.0, 1e-9)
@@ -376,11 +514,11 @@ def _levenberg_marquardt(
             damping *= 4.0
         if not accepted:
             break
-        gain = cost - new_cost
-        cor, points, cost = new_cor, new_points, new_cost
-        if gain < 1e-6 * max(cost, 1.0):
+        drop = cost - new_cost
+        cor, points, walk_gain, cost = new_cor, new_points, new_gain, new_cost
+        if drop < 1e-6 * max(cost, 1.0):
             break
-    return cor, points
+    return cor, points, walk_gain
 
 
 def place_turns(
@@ -392,18 +530,23 @@ def place_turns(
     outlier: float = 0.05,
     max_frames: int = 24,
     adjust: bool = True,
+    relearn: bool = True,
 ) -> tuple[LandmarkMap, np.ndarray]:
     """Landmarks from turns whose believed poses drifted, with each turn placed anew.
 
     The first turn (home, where the robot starts: the frame of the map) is taken as
     believed. Its frames alone place the first landmarks (the camera, ahead of the body,
-    circles as the body turns, which gives the rays a baseline). Every other turn is
-    then placed where its frames' changes fit those landmarks best: a search of body
-    shifts within ``search_m`` and first headings within ``search_deg`` (10 cm and 2°
-    steps, then 2 cm and 0.4°, then 1 cm and 0.2° around the best), the likelihood of
-    :meth:`LandmarkMap.log_likelihood`. With ``adjust``, every turn (with its turn
-    scale) and landmark is then adjusted together (:func:`adjust_turns`). The landmarks
-    are learned from every turn at its corrected pose.
+    circles as the body turns, which gives the rays a baseline). Every other turn, in
+    order, is then placed where its frames' changes fit the landmarks best: a search
+    (10 cm and 2° steps, then 2 cm and 0.4°, then 1 cm and 0.2° around the best) with the
+    likelihood of :meth:`LandmarkMap.log_likelihood`. A turn with a ``walk`` is searched
+    around where that walk from the placed turn before puts it (within 3σ of the walk's
+    spread, :data:`WALK_SIGMA_M` ..., which also weighs the search); one without, within
+    ``search_m`` and ``search_deg`` of its belief. With ``relearn`` the landmarks are
+    learned again from every turn placed so far after each one. With ``adjust``, every
+    turn (with its turn scale) and landmark is then adjusted together
+    (:func:`adjust_turns`, the walks included). The landmarks are learned from every
+    turn at its corrected pose.
 
     Parameters
     ----------
@@ -420,6 +563,8 @@ def place_turns(
         and the landmarks use every frame.
     adjust : bool
         Adjust turns and landmarks together after the search.
+    relearn : bool
+        Learn the landmarks again after each turn is placed (else from home's alone).
 
     Returns
     -------
@@ -427,7 +572,7 @@ def place_turns(
         From every turn at its corrected pose.
     corrections : numpy.ndarray
         ``(len(turns), 4)``: the :data:`Correction` ``(dx m, dy m, dyaw deg, turn scale)``
-        of each turn (:data:`NO_CORRECTION` for home).
+        of each turn (home's position and first heading unchanged: the map's frame).
     """
     if not turns:
         raise ValueError("no turns to place")
@@ -445,13 +590,32 @@ def place_turns(
         scored = LearnedTurn(
             t.x, t.y, tuple(t.frames[i] for i in _spread(len(t.frames), max_frames))
         )
-        best = corrections[k]
-        for reach_k, step in ((reach, 0.1), (0.1, 0.02), (0.02, 0.01)):
-            deg = reach_deg if step == 0.1 else 20.0 * reach_k
+        best, first_reach, first_deg = corrections[k], reach, reach_deg
+        prior = None
+        if t.walk is not None and t.frames and turns[k - 1].frames:
+            # where the walk from the placed turn before puts it, give or take the walk's
+            # spread (3 sigma searched)
+            x, y, yaw = _chained(turns[k - 1], corrections[k - 1], t.walk)
+            best = np.array([x - t.x, y - t.y, yaw - t.frames[0][1], 1.0])
+            s_m, s_deg = _walk_sigmas(t.walk)
+            first_reach, first_deg = min(reach, 3 * s_m), min(reach_deg, 3 * s_deg)
+            prior = (best.copy(), s_m, s_deg)
+        for reach_k, step in ((first_reach, 0.1), (0.1, 0.02), (0.02, 0.01)):
+            deg = first_deg if step == 0.1 else 20.0 * reach_k
             grid = _grid(best, (reach_k, deg, 0.0), (step, 20.0 * step, 0.0))
             ll = _turn_scores(landmarks, scored, grid, eye_forward_m, noise, outlier)
+            if prior is not None:
+                centre, s_m, s_deg = prior
+                ll = ll - 0.5 * (
+                    np.sum((grid[:, :2] - centre[:2]) ** 2, axis=1) / s_m**2
+                    + ((grid[:, 2] - centre[2]) / s_deg) ** 2
+                )
             best = grid[np.argmax(ll)]
         corrections[k] = best
+        if relearn:
+            landmarks = learn_landmarks(
+                _views(turns[: k + 1], corrections[: k + 1], eye_forward_m), min_positions=2
+            )
     if adjust:
         first = learn_landmarks(_views(turns, corrections, eye_forward_m))
         corrections, _ = adjust_turns(turns, first, corrections, eye_forward_m, noise_deg=noise_deg)

@@ -29,7 +29,7 @@ from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, Vi
 from vc_gym.compass.bearings import frame_bearings
 from vc_gym.compass.turn_placement import LearnedTurn, place_turns
 from vc_gym.filters import HeadingGridFilter
-from vc_gym.poses import compose
+from vc_gym.poses import body_to_world, compose, world_to_body
 from vc_gym.sim.robot import EYE_OFFSET_M
 from vc_gym.validation import (
     MAX_HALF_LIFE_S,
@@ -270,6 +270,10 @@ class ScriptedLearner:
         #: with ``config.landmarks``: every turn learned, its frames' colour changes at
         #: the body headings the odometry counted (home first)
         self.turns: list[LearnedTurn] = []
+        # the odometry alone, heading unwrapped (the belief's heading follows the home
+        # map), and where it stood at the last learning frame: the walks between turns
+        self.odometry = np.zeros(3)
+        self._last_frame_odometry: np.ndarray | None = None
 
     def _act(self, forward: float = 0.0, turn: float = 0.0, pan: float = 0.0) -> None:
         self.steps_taken += 1
@@ -280,6 +284,8 @@ class ScriptedLearner:
         self.turn_accum += dth
         x, y, th = compose(tuple(self.belief), (dx, dy, dth))
         self.belief = np.array([x, y, th])
+        ox, oy = body_to_world(dx, dy, self.odometry[2])
+        self.odometry += (ox, oy, dth)
         if terminated:
             raise RobotFell()
         if self.learn_filter is not None and self.home_compass is not None:
@@ -378,6 +384,8 @@ class ScriptedLearner:
         elif isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
             raise ValueError(f"steps must be an int >= 1, got {steps!r}")
         self.belief = np.zeros(3)
+        self.odometry = np.zeros(3)
+        self._last_frame_odometry = None
         self.learn_filter = None
         self.home_compass = None
         self.rot_scale = 1.0
@@ -472,16 +480,28 @@ class ScriptedLearner:
                 path.append(tuple(float(v) for v in self.info["pose"]))
                 if self.config.landmarks:
                     if start is None:
-                        start = (*self.belief, self.turn_accum)
+                        start = (*self.belief, self.turn_accum, self._walk())
                     # the heading belief follows the home map, whose parallax bends it
                     # away from home; the odometry counts the turn itself well
                     yaw = start[2] + self.turn_accum - start[3]
                     changes = frame_bearings(self.obs["image"], self.camera, colors)
                     frames.append((changes, float(yaw), pan))
+                    self._last_frame_odometry = self.odometry.copy()
                 bar.update()
         if frames:
-            self.turns.append(LearnedTurn(float(start[0]), float(start[1]), tuple(frames)))
+            self.turns.append(
+                LearnedTurn(float(start[0]), float(start[1]), tuple(frames), start[4])
+            )
         return vc
+
+    def _walk(self) -> tuple[float, float, float] | None:
+        """The odometry's ``(forward, left, turn)`` since the last learning frame, in the
+        body's frame there (``None`` before the first)."""
+        last = self._last_frame_odometry
+        if last is None:
+            return None
+        forward, left = world_to_body(*(self.odometry[:2] - last[:2]), last[2])
+        return float(forward), float(left), float(self.odometry[2] - last[2])
 
     def _learn_around(
         self,
@@ -525,6 +545,7 @@ class ScriptedLearner:
                 self._act(pan=self._next_pan())
                 frames.append((self.obs["image"], self.turn_accum, float(self.obs["head"][0]), k))
                 self.turn_path.append(tuple(float(v) for v in self.info["pose"]))
+                self._last_frame_odometry = self.odometry.copy()
         self._turn_to(start)
         for _ in range(3):
             self._act()
