@@ -81,6 +81,7 @@ def _with_landmarks(atlas, tmp_path, **changes):
         "std_m": np.array([0.01, 0.02]),
         "support": np.array([4, 7]),
         "n_colors": n,
+        "eye_forward_m": 0.25,
     }
     fields.update(changes)
     atlas.landmarks = LandmarkMap(**fields)
@@ -96,6 +97,7 @@ def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
     np.testing.assert_array_equal(loaded.positions, [[2.0, -1.0], [-2.5, 0.5]])
     assert loaded.pairs.tolist()[0] == 3 and loaded.support.tolist() == [4, 7]
     assert loaded.n_colors == room_atlas.compasses[0].config.n_colors
+    assert loaded.eye_forward_m == 0.25  # where the camera sat: the sensor's too
 
 
 @pytest.mark.parametrize(
@@ -108,6 +110,8 @@ def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
         ({"std_m": np.array([-0.1, 0.1])}, "std_m"),
         ({"support": np.array([1, 5])}, "2 positions"),
         ({"std_m": np.array([0.1])}, "count"),
+        ({"eye_forward_m": 5.0}, "eye_forward_m"),
+        ({"eye_forward_m": float("nan")}, "eye_forward_m"),
     ],
 )
 def test_bad_landmarks_in_a_file_are_refused(room_atlas, tmp_path, changes, message):

@@ -10,7 +10,7 @@ import pytest
 from striped_room import HFOV, PALETTE, learned_views, striped_room, true_offsets, view
 
 from vc_gym.compass import Camera
-from vc_gym.compass.bearings import frame_bearings
+from vc_gym.compass.bearings import bands_bearings, frame_bearings
 from vc_gym.compass.landmarks import LearnedView, learn_landmarks
 from vc_gym.localization.bearing_sensor import BearingSensor
 
@@ -68,9 +68,7 @@ def test_the_likelihood_peaks_at_the_true_pose(striped, learned):
             assert math.hypot(best[0] - x, best[1] - y) < 0.04, best
             at_truth = ll[np.argmin(np.hypot(poses[:, 0] - x, poses[:, 1] - y))]
     # the true heading beats one degree off at the best positions
-    worse = [
-        sensor.pose_log_likelihood(obs, np.array([[x, y, yaw + d]]))[0] for d in (-1.0, 1.0)
-    ]
+    worse = [sensor.pose_log_likelihood(obs, np.array([[x, y, yaw + d]]))[0] for d in (-1.0, 1.0)]
     assert at_truth > max(worse)
 
 
@@ -88,7 +86,7 @@ def test_a_stray_change_does_not_move_the_best_pose(striped, learned):
     assert np.argmax(clean) == 0 and np.argmax(noisy) == 0
 
 
-def test_bad_inputs_are_refused(learned):
+def test_bad_inputs_are_refused(striped, learned):
     colors, views = learned
     sensor = BearingSensor(learn_landmarks(views), colors)
     with pytest.raises(ValueError, match="shape"):
@@ -110,9 +108,13 @@ def test_bad_inputs_are_refused(learned):
         lm.log_likelihood(found, np.zeros((1, 2)), np.zeros(1), 0.01, 1.5)
     with pytest.raises(ValueError, match="band_deg"):
         frame_bearings(np.zeros((40, 52, 3), np.uint8), Camera(), colors, band_deg=(5.0, 1.0))
-    for band in ((5.0, 1.0), (1.0,), "high", (0.0, float("inf"))):
-        with pytest.raises(ValueError, match="band_deg"):  # when the sensor is made
-            BearingSensor(learn_landmarks(views), colors, band_deg=band)
+    for bands in ([(5.0, 1.0)], [(1.0,)], "high", [(0.0, float("inf"))], [], [(0.5, 4.0)] * 17):
+        with pytest.raises(ValueError, match="band"):
+            bands_bearings(np.zeros((40, 52, 3), np.uint8), Camera(), colors, bands_deg=bands)
+    # changes read in other bands than the map's are refused, not matched wrongly
+    other = bands_bearings(view(striped[0], 0.0, 0.0, 0.0)[0], Camera(hfov_deg=HFOV), colors)
+    with pytest.raises(ValueError, match="bands"):
+        lm.log_likelihood(other, np.zeros((1, 2)), np.zeros(1), 0.01, 0.05)
 
 
 def test_the_camera_ahead_of_the_body_is_where_the_bearings_are_seen_from(striped, learned):

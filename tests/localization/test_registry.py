@@ -66,7 +66,7 @@ def test_an_instance_is_used_as_is():
 @pytest.mark.parametrize(
     ("spec", "match"),
     [
-        ("kalmann", "known: \\['grid', 'kalman', 'particle'"),
+        ("kalmann", "known: \\['bearings', 'grid', 'kalman', 'particle'"),
         ({"n_particles": 5}, "'type'"),
         ({"type": "magic"}, "unknown tracker"),
         ({"type": "grid", "lambda": 0.2}, "bad arguments"),

@@ -58,9 +58,9 @@ def walk(room, illumination: float = 1.0):
 #: spots, the session light kept by their SpotShortlist); the pose tracker scores poses
 #: on maps re-drawn for them instead (tests/localization/test_pose_tracker.py), and
 #: pose-grid answers with either (tests/localization/test_home_switch_tracker.py).
-SPOT_SCORING = sorted(set(TRACKERS) - {"pose", "pose-grid"})
+SPOT_SCORING = sorted(set(TRACKERS) - {"pose", "pose-grid", "bearings"})
 #: The trackers whose state holds the frame's goodness of every spot.
-GOODNESS = sorted(set(TRACKERS) - {"pose"})
+GOODNESS = sorted(set(TRACKERS) - {"pose", "bearings"})
 
 
 @pytest.fixture(scope="module")
@@ -183,6 +183,7 @@ def test_trackers_keep_the_session_light_of_a_session_atlas(
     states = run(tracker, session_atlas, dark)
     lights = {
         "pose": lambda t: [t.light],
+        "bearings": lambda t: [t.light],
         "pose-grid": lambda t: [t.far.light, t.near.spots.light],
     }.get(name, lambda t: [t.spots.light])(tracker)
     for light in lights:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vc_gym.compass.bearings import FrameBearings
+from vc_gym.compass.bearings import DEFAULT_BAND_DEG, MAX_BANDS, FrameBearings, check_bands
 from vc_gym.validation import MAX_ABS_METRES, finite_float, int_at_least, positive_float
 
 __all__ = [
@@ -89,14 +89,19 @@ class LandmarkMap:
     positions : numpy.ndarray
         ``(M, 2)`` landmark positions (m).
     pairs : numpy.ndarray
-        ``(M,)`` colour-pair code of each (``left * n_colors + right``, as the camera
-        sees it from inside the room).
+        ``(M,)`` band and colour-pair code of each (:attr:`FrameBearings.pairs`: the
+        classes as the camera sees them from inside the room).
     std_m : numpy.ndarray
         ``(M,)`` position uncertainty, the root mean square of the covariance's axes.
     support : numpy.ndarray
         ``(M,)`` how many learning positions saw it.
     n_colors : int
         Number of colour classes of the map.
+    eye_forward_m : float
+        How far ahead of the body's centre the camera that learned the map sat (a
+        sensor predicts bearings from there for a body pose).
+    bands : tuple of (float, float)
+        The bands the changes were read in (:func:`~vc_gym.compass.bearings.bands_bearings`).
     """
 
     positions: np.ndarray
@@ -104,6 +109,8 @@ class LandmarkMap:
     std_m: np.ndarray
     support: np.ndarray
     n_colors: int
+    eye_forward_m: float = 0.0
+    bands: tuple[tuple[float, float], ...] = (DEFAULT_BAND_DEG,)
 
     def __len__(self) -> int:
         return int(self.pairs.size)
@@ -150,6 +157,11 @@ class LandmarkMap:
         total = np.zeros(len(eye_xy))
         if len(bearings) == 0:
             return total
+        if tuple(bearings.bands) != tuple(self.bands) or bearings.n_colors != self.n_colors:
+            raise ValueError(
+                f"the frame's changes were read in bands {bearings.bands} with "
+                f"{bearings.n_colors} colours, the map's in {self.bands} with {self.n_colors}"
+            )
         half = math.radians(bearings.hfov_deg) / 2.0
         log_floor = math.log(outlier)
         observed_pairs = bearings.pairs
@@ -181,6 +193,8 @@ class LandmarkMap:
             f"{prefix}pairs": self.pairs.astype(np.int64),
             f"{prefix}std_m": self.std_m.astype(np.float64),
             f"{prefix}support": self.support.astype(np.int64),
+            f"{prefix}eye_forward_m": np.array(self.eye_forward_m, np.float64),
+            f"{prefix}bands": np.array(self.bands, np.float64).reshape(-1, 2),
         }
 
     @classmethod
@@ -194,8 +208,10 @@ class LandmarkMap:
         ValueError
             On a missing entry, a wrong shape or dtype, more than :data:`MAX_LANDMARKS`,
             positions beyond ±``MAX_ABS_METRES`` or not finite, a pair code outside the
-            ``n_colors`` classes, a negative or non-finite uncertainty, or a support
-            below 2.
+            ``n_colors`` classes, a negative or non-finite uncertainty, a support
+            below 2, a camera offset that is not one number within ±1 m (a map
+            without one has the camera at the body's centre), or bands that are not 1 to
+            ``MAX_BANDS`` pairs of elevations (a map without them: the one default band).
         """
         missing = [k for k in _KEYS if prefix + k not in arrays]
         if missing:
@@ -212,28 +228,40 @@ class LandmarkMap:
             raise ValueError("landmark pairs and support must be integers")
         if not np.all(np.isfinite(pos)) or np.any(np.abs(pos) > MAX_ABS_METRES):
             raise ValueError(f"landmark positions must be finite and within ±{MAX_ABS_METRES:g} m")
-        if np.any(pairs < 0) or np.any(pairs >= n_colors * n_colors):
-            raise ValueError(f"landmark pair codes must name two of {n_colors} colour classes")
+        raw_bands = np.asarray(arrays.get(prefix + "bands", np.array([DEFAULT_BAND_DEG])))
+        if raw_bands.dtype.kind != "f" or raw_bands.ndim != 2 or raw_bands.shape[1] != 2:
+            raise ValueError("landmark bands must be (B, 2) float elevations")
+        if not 1 <= len(raw_bands) <= MAX_BANDS:
+            raise ValueError(f"landmark bands must number 1 to {MAX_BANDS}")
+        bands = check_bands(raw_bands.tolist())
+        if np.any(pairs < 0) or np.any(pairs >= len(bands) * n_colors * n_colors):
+            raise ValueError(
+                f"landmark pair codes must name one of {len(bands)} bands and two of "
+                f"{n_colors} colour classes"
+            )
         if not np.all(np.isfinite(std)) or np.any(std < 0):
             raise ValueError("landmark std_m must be finite and non-negative")
         if np.any(support < 2):
             raise ValueError("a landmark is seen from at least 2 positions")
+        eye = np.asarray(arrays.get(prefix + "eye_forward_m", 0.0))
+        if eye.shape != () or eye.dtype.kind != "f" or not abs(float(eye)) <= 1.0:
+            raise ValueError("landmark eye_forward_m must be one float within ±1 m")
         return cls(
             pos.astype(np.float64), pairs.astype(np.int64), std.astype(np.float64),
-            support.astype(np.int64), int(n_colors),
+            support.astype(np.int64), int(n_colors), float(eye), bands,
         )  # fmt: skip
 
 
-def _rays(views: Iterable[LearnedView]) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+def _rays(views: Iterable[LearnedView]) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, tuple]:
     """Every change of every view as a world ray: origins (R, 2), bearings (R,) in
-    radians, pair codes (R,); and the number of colours."""
-    origins, angles, pairs, n_colors = [], [], [], None
+    radians, pair codes (R,); the number of colours and the bands."""
+    origins, angles, pairs, n_colors, bands = [], [], [], None, None
     for v in views:
         b = v.bearings
         if n_colors is None:
-            n_colors = b.n_colors
-        elif b.n_colors != n_colors:
-            raise ValueError("the views' bearings use different colour classes")
+            n_colors, bands = b.n_colors, tuple(b.bands)
+        elif b.n_colors != n_colors or tuple(b.bands) != bands:
+            raise ValueError("the views' bearings use different colour classes or bands")
         if not all(math.isfinite(t) for t in (v.camera_yaw_deg, v.x, v.y)):
             raise ValueError(f"a view's pose must be finite, got {(v.x, v.y, v.camera_yaw_deg)}")
         origins.append(np.broadcast_to([v.x, v.y], (len(b), 2)))
@@ -242,7 +270,7 @@ def _rays(views: Iterable[LearnedView]) -> tuple[np.ndarray, np.ndarray, np.ndar
     if n_colors is None:
         raise ValueError("no views to learn landmarks from")
     cat = np.concatenate
-    return cat(origins).astype(np.float64), cat(angles), cat(pairs), n_colors
+    return cat(origins).astype(np.float64), cat(angles), cat(pairs), n_colors, bands
 
 
 def _merge_repeats(o: np.ndarray, a: np.ndarray, merge: float) -> tuple[np.ndarray, np.ndarray]:
@@ -376,7 +404,7 @@ def learn_landmarks(
     max_range = positive_float("max_range_m", max_range_m)
     floor = math.radians(positive_float("resolution_deg", resolution_deg))
     merge = math.radians(positive_float("merge_deg", merge_deg))
-    origins, angles, pairs, n_colors = _rays(views)
+    origins, angles, pairs, n_colors, bands = _rays(views)
     rng = np.random.default_rng(0)  # the candidates drawn when there are too many
     found: list[tuple[np.ndarray, int, float, int]] = []
     for pair in np.unique(pairs):
@@ -400,11 +428,12 @@ def learn_landmarks(
             free[rays] = False
     if not found:
         none = np.zeros(0, np.int64)
-        return LandmarkMap(np.zeros((0, 2)), none, np.zeros(0), none, n_colors)
+        return LandmarkMap(np.zeros((0, 2)), none, np.zeros(0), none, n_colors, bands=bands)
     return LandmarkMap(
         np.array([f[0] for f in found], np.float64),
         np.array([f[1] for f in found], np.int64),
         np.array([f[2] for f in found], np.float64),
         np.array([f[3] for f in found], np.int64),
         n_colors,
+        bands=bands,
     )

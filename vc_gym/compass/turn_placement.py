@@ -13,7 +13,7 @@ corrected pose (:func:`~vc_gym.compass.landmarks.learn_landmarks`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -345,13 +345,14 @@ def adjust_turns(
     scale_sigma: float = 0.02,
     associations: int = 3,
     max_steps: int = 20,
+    known: object = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Adjust the turns' corrections and the landmarks' positions together (a bundle
     adjustment of the bearings).
 
     Every change of every frame is matched to the landmark of its colour pair whose
     predicted bearing is nearest within ``gate_deg``; then the corrections of every turn
-    (of the first, home, only its turn scale: its position and first heading are the
+    (of a ``known`` turn only its turn scale: its position and first heading are the
     map's frame) and the positions of the matched landmarks minimise the Huber cost (3σ)
     of the bearing residuals, ``observed - predicted`` over
     ``noise_deg``, with a Gaussian prior of ``scale_sigma`` on each turn scale around 1
@@ -379,17 +380,21 @@ def adjust_turns(
         Rounds of matching and adjusting (at least 1).
     max_steps : int
         Levenberg-Marquardt steps per round (at least 1).
+    known : sequence of bool, optional
+        Which turns stood where given (position and first heading); default the first
+        only (home), which must be known.
 
     Returns
     -------
     corrections : numpy.ndarray
-        ``(len(turns), 4)``; the first turn's position and heading unchanged.
+        ``(len(turns), 4)``; the known turns' positions and headings unchanged.
     positions : numpy.ndarray
         ``(len(landmarks), 2)`` the landmarks' adjusted positions (those never matched,
         or beyond :data:`MAX_ADJUSTED_LANDMARKS`, where they were).
     """
     if not turns:
         raise ValueError("no turns to adjust")
+    pinned = _known_turns(known, len(turns))
     cor = np.array(corrections, dtype=np.float64)
     if cor.shape != (len(turns), 4) or not np.all(np.isfinite(cor)):
         raise ValueError(f"corrections must be finite, ({len(turns)}, 4), got {cor.shape}")
@@ -423,12 +428,24 @@ def adjust_turns(
         c = changes.subset(keep)
         lm = slot[match[keep]]
         cor, positions[moved], walk_gain = _levenberg_marquardt(
-            where, cor, positions[moved], walk_gain, c, lm, walks, eye_forward_m, noise,
-            scale_sigma, max_steps,
+            where, cor, positions[moved], walk_gain, c, lm, walks, pinned, eye_forward_m,
+            noise, scale_sigma, max_steps,
         )  # fmt: skip
     cor[:, 2] = np.degrees(cor[:, 2])
-    cor[0, :3] = corrections[0][:3]  # held by the stiff prior; exactly as given
+    cor[pinned, :3] = np.asarray(corrections)[pinned, :3]  # held stiffly; exactly as given
     return cor, positions
+
+
+def _known_turns(known: object, n: int) -> np.ndarray:
+    """Indices of the known turns (default: the first), checked."""
+    if known is None:
+        return np.zeros(1, np.int64)
+    mask = np.asarray(known)
+    if mask.shape != (n,) or mask.dtype != bool:
+        raise ValueError(f"known must be {n} booleans, one per turn, got {known!r}")
+    if not mask[0]:
+        raise ValueError("the first turn must be known: it is the map's frame")
+    return np.flatnonzero(mask)
 
 
 def _levenberg_marquardt(
@@ -439,14 +456,15 @@ def _levenberg_marquardt(
     c: _Changes,
     lm: np.ndarray,
     walks: _Walks,
+    pinned: np.ndarray,
     eye_forward_m: float,
     noise: float,
     scale_sigma: float,
     max_steps: int,
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The steps of :func:`adjust_turns` for one matching. The parameters are the turns'
-    corrections (4 each, heading in radians; the first turn's position and heading held
-    by a stiff prior, :data:`_PIN`: the map's frame), the points (2 each) and the gain
+    corrections (4 each, heading in radians; the ``pinned`` turns' positions and first
+    headings held by a stiff prior, :data:`_PIN`: the map's frame), the points (2 each) and the gain
     of the odometry's walk lengths."""
     n_turns = len(cor)
     n_turn, n = 4 * n_turns, 4 * n_turns + 2 * len(points) + 1
@@ -466,9 +484,15 @@ def _levenberg_marquardt(
         )
         return r, jac / noise
 
+    held = cor[pinned, :3].copy()
+
     def priors(cr: np.ndarray, gain: float) -> np.ndarray:
         return np.concatenate(
-            [(cr[:, 3] - 1.0) / scale_sigma, cr[0, :3] / _PIN, [(gain - 1.0) / WALK_GAIN_SIGMA]]
+            [
+                (cr[:, 3] - 1.0) / scale_sigma,
+                ((cr[pinned, :3] - held) / _PIN).ravel(),
+                [(gain - 1.0) / WALK_GAIN_SIGMA],
+            ]
         )
 
     def total_cost(cr: np.ndarray, pts: np.ndarray, gain: float) -> float:
@@ -480,9 +504,14 @@ def _levenberg_marquardt(
             + 0.5 * float(chain @ chain)
         )
 
-    prior_cols = np.concatenate([scale_cols, [0, 1, 2], [n - 1]])
+    pin_cols = (4 * pinned[:, None] + np.arange(3)).ravel()
+    prior_cols = np.concatenate([scale_cols, pin_cols, [n - 1]])
     prior_w = np.concatenate(
-        [np.full(n_turns, 1.0 / scale_sigma), np.full(3, 1.0 / _PIN), [1.0 / WALK_GAIN_SIGMA]]
+        [
+            np.full(n_turns, 1.0 / scale_sigma),
+            np.full(pin_cols.size, 1.0 / _PIN),
+            [1.0 / WALK_GAIN_SIGMA],
+        ]
     )
     damping = 1e-3
     cost = total_cost(cor, points, walk_gain)
@@ -531,13 +560,15 @@ def place_turns(
     max_frames: int = 24,
     adjust: bool = True,
     relearn: bool = True,
+    known: object = None,
 ) -> tuple[LandmarkMap, np.ndarray]:
     """Landmarks from turns whose believed poses drifted, with each turn placed anew.
 
-    The first turn (home, where the robot starts: the frame of the map) is taken as
-    believed. Its frames alone place the first landmarks (the camera, ahead of the body,
-    circles as the body turns, which gives the rays a baseline). Every other turn, in
-    order, is then placed where its frames' changes fit the landmarks best: a search
+    The first turn (home, where the robot starts: the frame of the map), and any other
+    ``known`` turn, is taken as believed. Their frames alone place the first landmarks
+    (the camera, ahead of the body, circles as the body turns, which gives the rays a
+    baseline). Every other turn, in order, is then placed where its frames' changes fit
+    the landmarks best: a search
     (10 cm and 2° steps, then 2 cm and 0.4°, then 1 cm and 0.2° around the best) with the
     likelihood of :meth:`LandmarkMap.log_likelihood`. A turn with a ``walk`` is searched
     around where that walk from the placed turn before puts it (within 3σ of the walk's
@@ -564,7 +595,11 @@ def place_turns(
     adjust : bool
         Adjust turns and landmarks together after the search.
     relearn : bool
-        Learn the landmarks again after each turn is placed (else from home's alone).
+        Learn the landmarks again after each turn is placed (else from the known turns'
+        alone).
+    known : sequence of bool, optional
+        Which turns stood where believed (position and first heading: e.g. a robot
+        placed at known spots); default the first only, which must be known.
 
     Returns
     -------
@@ -582,10 +617,12 @@ def place_turns(
     noise = math.radians(positive_float("noise_deg", noise_deg))
     int_at_least("max_frames", max_frames, 1)
     corrections = np.tile(np.asarray(NO_CORRECTION, np.float64), (len(turns), 1))
-    # home alone: each edge is seen from two or three camera positions a few decimetres
-    # apart (rough, but enough to place the other turns near their truth)
-    landmarks = learn_landmarks(turns[0].views(eye_forward_m), min_positions=2)
-    for k in range(1, len(turns)):
+    # the known turns alone (home: each edge seen from two or three camera positions a
+    # few decimetres apart; rough, but enough to place the other turns near their truth)
+    pinned = _known_turns(known, len(turns))
+    known_views = _views([turns[k] for k in pinned], corrections[pinned], eye_forward_m)
+    landmarks = learn_landmarks(known_views, min_positions=2)
+    for k in sorted(set(range(1, len(turns))) - set(pinned.tolist())):
         t = turns[k]
         scored = LearnedTurn(
             t.x, t.y, tuple(t.frames[i] for i in _spread(len(t.frames), max_frames))
@@ -612,14 +649,17 @@ def place_turns(
                 )
             best = grid[np.argmax(ll)]
         corrections[k] = best
-        if relearn:
-            landmarks = learn_landmarks(
-                _views(turns[: k + 1], corrections[: k + 1], eye_forward_m), min_positions=2
-            )
+        if relearn:  # from the known turns and those placed so far
+            placed = sorted(set(pinned.tolist()) | set(range(k + 1)))
+            views = _views([turns[j] for j in placed], corrections[placed], eye_forward_m)
+            landmarks = learn_landmarks(views, min_positions=2)
     if adjust:
         first = learn_landmarks(_views(turns, corrections, eye_forward_m))
-        corrections, _ = adjust_turns(turns, first, corrections, eye_forward_m, noise_deg=noise_deg)
-    return learn_landmarks(_views(turns, corrections, eye_forward_m)), corrections
+        corrections, _ = adjust_turns(
+            turns, first, corrections, eye_forward_m, noise_deg=noise_deg, known=known
+        )
+    landmarks = learn_landmarks(_views(turns, corrections, eye_forward_m))
+    return replace(landmarks, eye_forward_m=eye_forward_m), corrections
 
 
 def _views(turns: list[LearnedTurn], corrections: np.ndarray, eye_forward_m: float) -> list:

@@ -19,14 +19,14 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 from tqdm import tqdm
 
 from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.compass.bearings import frame_bearings
+from vc_gym.compass.bearings import bands_bearings
 from vc_gym.compass.turn_placement import LearnedTurn, place_turns
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import body_to_world, compose, world_to_body
@@ -125,7 +125,7 @@ class LearningConfig:
         spots. At most half of ``spot_distance_m``.
     landmarks : bool
         Beyond the paper: keep every learned turn's colour changes at their bearings
-        (:func:`~vc_gym.compass.bearings.frame_bearings`), place the turns anew where
+        (:func:`~vc_gym.compass.bearings.bands_bearings`), place the turns anew where
         their changes agree (:func:`~vc_gym.compass.turn_placement.place_turns`) and
         keep the changes' positions as the atlas' ``landmarks``
         (:class:`~vc_gym.compass.landmarks.LandmarkMap`), what a bearing tracker
@@ -484,7 +484,7 @@ class ScriptedLearner:
                     # the heading belief follows the home map, whose parallax bends it
                     # away from home; the odometry counts the turn itself well
                     yaw = start[2] + self.turn_accum - start[3]
-                    changes = frame_bearings(self.obs["image"], self.camera, colors)
+                    changes = bands_bearings(self.obs["image"], self.camera, colors)
                     frames.append((changes, float(yaw), pan))
                     self._last_frame_odometry = self.odometry.copy()
                 bar.update()
@@ -575,7 +575,7 @@ class ScriptedLearner:
                     y0,
                     tuple(
                         (
-                            frame_bearings(image, self.camera, colors),
+                            bands_bearings(image, self.camera, colors),
                             start + turn * self.rot_scale,
                             pan,
                         )
@@ -775,6 +775,12 @@ class GridLearning:
         """
         _check_config(config)
         maps, path, colors, scale = {}, [], None, 1.0
+        turns: list[LearnedTurn] = []  # with landmarks: every turn, where it was placed
+
+        def keep_turn(learner: ScriptedLearner, place: tuple[float, float]) -> None:
+            if config.landmarks:  # learned in the frame of the robot placed facing 0°
+                turns.append(replace(learner.turns[0], x=place[0], y=place[1]))
+
         for i, spot in enumerate(self.spots):
             room.reset(options={"pose": (*spot, 0.0)})
             learner = ScriptedLearner(room, config)
@@ -782,6 +788,7 @@ class GridLearning:
             if colors is None:
                 colors, scale = compass.colors, learner.rot_scale
             path.extend(learner.turn_path)
+            keep_turn(learner, spot)
             steps = self.around_steps or max(1, learner.steps_per_direction() // 4)
             name = f"{self.prefix}{i}"
             maps[name] = (spot, compass)
@@ -789,13 +796,21 @@ class GridLearning:
                 room.reset(options={"pose": (*place, 0.0)})
                 turn = learner.learn_turn(steps, colors=colors)
                 path.extend(learner.turn_path)
+                keep_turn(learner, place)
                 if self.keep_around:
                     maps[f"{name}.{side}"] = (place, turn)
                 else:
                     compass.merge(turn)
         atlas = CompassAtlas(maps, home=f"{self.prefix}0")
+        corrections = None
+        if config.landmarks:
+            # every turn stood where the robot was placed: only the turns' scales are
+            # adjusted with the landmarks
+            atlas.landmarks, corrections = place_turns(
+                turns, eye_forward_m=EYE_OFFSET_M[0], known=[True] * len(turns)
+            )
         names = {n: p for n, (p, _) in maps.items()}
-        return LearningResult(atlas, names, path, scale)
+        return LearningResult(atlas, names, path, scale, corrections, turns)
 
 
 def kidnap_pose(

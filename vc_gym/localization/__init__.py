@@ -16,7 +16,9 @@ Every tracker satisfies :class:`Tracker`: ``reset(atlas, camera, dt_s)`` and
 * :class:`PoseTracker` -- a pose belief over the whole field: particles weighed by every
   spot's map re-drawn for their position, sensor resetting when the belief is lost;
 * :class:`HomeSwitchTracker` -- the pose tracker's state away from home, the grid
-  tracker's near it (``"pose-grid"``).
+  tracker's near it (``"pose-grid"``);
+* :class:`BearingTracker` -- the pose tracker's particles weighed also by the bearings
+  of the atlas' landmarks (``"bearings"``).
 
 Each takes ``shortlist=k`` to score only the ``k`` best-fitting spots between full
 scorings (:class:`SpotShortlist`): an atlas with many spots then costs about ``k``
@@ -39,6 +41,7 @@ only inside the spots' hull), from the spots' score vectors (:func:`mean_spot_sc
 >>> state = tracker.update(image, head_pan_deg=20.0, odometry=(0.02, 0.0, 1.5))  # doctest: +SKIP
 """
 
+from vc_gym.localization.bearing_tracker import BearingTracker
 from vc_gym.localization.compass_sensors import (
     AtlasPoseSensor,
     CompassHeadingSensor,
@@ -67,6 +70,7 @@ __all__ = [
     "TRACKERS",
     "AtlasPoseSensor",
     "AtlasPositionFilter",
+    "BearingTracker",
     "CompassHeadingSensor",
     "GoodnessCalibration",
     "GridTracker",

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from vc_gym.compass.bearings import DEFAULT_BAND_DEG, FrameBearings, check_band, frame_bearings
+from vc_gym.compass.bearings import FrameBearings, bands_bearings
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.landmarks import LandmarkMap, eye_positions
@@ -46,11 +46,10 @@ class BearingSensor:
     outlier : float
         Probability density floor, relative to a perfect match, for a change that no
         landmark explains, in ``(0, 1)``.
-    band_deg : tuple of float
-        The horizon band the changes are read in (see ``frame_bearings``).
-    eye_forward_m : float
+    eye_forward_m : float, optional
         How far ahead of the body's centre, along its heading, the camera sits (a
-        pose is the body's; the bearings are seen from the camera).
+        pose is the body's; the bearings are seen from the camera); default the
+        landmarks' own (:attr:`LandmarkMap.eye_forward_m`).
     """
 
     def __init__(
@@ -60,8 +59,7 @@ class BearingSensor:
         camera: Camera | None = None,
         noise_deg: float = 0.5,
         outlier: float = 0.05,
-        band_deg: tuple[float, float] = DEFAULT_BAND_DEG,
-        eye_forward_m: float = 0.0,
+        eye_forward_m: float | None = None,
     ):
         if not isinstance(landmarks, LandmarkMap):
             raise ValueError(f"landmarks must be a LandmarkMap, got {type(landmarks).__name__}")
@@ -78,18 +76,21 @@ class BearingSensor:
         if outlier >= 1.0:
             raise ValueError(f"outlier must be in (0, 1), got {outlier}")
         self.outlier = outlier
-        self.band_deg = check_band(band_deg)
+        if eye_forward_m is None:
+            eye_forward_m = landmarks.eye_forward_m
         self.eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
 
     def bearings(self, image: np.ndarray) -> FrameBearings:
-        """The changes of one frame (what :meth:`pose_log_likelihood` reads)."""
-        return frame_bearings(image, self.camera, self.colors, self.band_deg)
+        """The changes of one frame in the landmarks' bands (what
+        :meth:`pose_log_likelihood` reads)."""
+        return bands_bearings(image, self.camera, self.colors, self.landmarks.bands)
 
     def pose_log_likelihood(
         self,
         observation: np.ndarray | FrameBearings,
         poses: np.ndarray,
         head_pan_deg: float = 0.0,
+        noise_deg: float | None = None,
     ) -> np.ndarray:
         """``log p(frame | pose)`` up to a constant, for every row of ``poses``.
 
@@ -101,6 +102,9 @@ class BearingSensor:
             ``(N, 3)`` body poses ``x`` (m), ``y`` (m), ``θ`` (deg).
         head_pan_deg : float
             Head pan when the frame was taken (left positive).
+        noise_deg : float, optional
+            σ of a bearing for this call (e.g. widened while a belief is still broad);
+            default the sensor's.
 
         Returns
         -------
@@ -112,6 +116,7 @@ class BearingSensor:
         theta = np.radians(p[:, 2])
         eye = eye_positions(p[:, :2], theta, self.eye_forward_m)
         camera_yaw = theta + math.radians(head_pan_deg)
+        noise = self.noise_deg if noise_deg is None else positive_float("noise_deg", noise_deg)
         return self.landmarks.log_likelihood(
-            obs, eye, camera_yaw, math.radians(self.noise_deg), self.outlier
+            obs, eye, camera_yaw, math.radians(noise), self.outlier
         )

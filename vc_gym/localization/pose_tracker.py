@@ -313,6 +313,7 @@ class PoseTracker:
         scores = self._spot_scores(terms) if check else None
         if scores is not None:
             self._check_lost(scores, ll)
+        ll = ll + self._fine_log_likelihood(pan, pf.particles)
         top = float(ll.max())
         robust = np.log(self.outlier + (1.0 - self.outlier) * np.exp(ll - top))
         pf.update(_Given(robust), None)
@@ -327,6 +328,12 @@ class PoseTracker:
                     pf.resample()
                 idx = self.rng.choice(self.n_particles, size=n, replace=False)
                 pf.replace(idx, self._drawn(scores, pan, n))
+
+    def _fine_log_likelihood(self, pan: float, poses: np.ndarray) -> np.ndarray | float:
+        """A further measurement's log-likelihood at the particles, added to the maps'
+        after the kidnapping check (which compares the maps' alone); none here."""
+        del pan, poses
+        return 0.0
 
     def _spot_scores(self, terms: FrameTerms) -> np.ndarray:
         """``(n_spots, n_headings)`` tempered log-likelihood at every spot's position."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from vc_gym.localization.bearing_tracker import BearingTracker
 from vc_gym.localization.grid_tracker import GridTracker
 from vc_gym.localization.home_switch_tracker import HomeSwitchTracker
 from vc_gym.localization.kalman_tracker import KalmanTracker
@@ -22,6 +23,7 @@ TRACKERS: dict[str, Callable[..., Tracker]] = {
     "kalman": KalmanTracker,
     "pose": PoseTracker,
     "pose-grid": HomeSwitchTracker,
+    "bearings": BearingTracker,
 }
 
 TrackerSpec = str | Mapping[str, Any] | Callable[[], Tracker] | Tracker | None
@@ -40,7 +42,8 @@ def make_tracker(spec: TrackerSpec = "grid") -> Tracker:
     spec : str, dict, callable or Tracker
         ``"grid"`` (the paper's filters, default), ``"particle"``, ``"kalman"``,
         ``"pose"`` (a pose belief over the whole field on re-drawn maps),
-        ``"pose-grid"`` (the pose belief away from home, the paper's filters near it) or any
+        ``"pose-grid"`` (the pose belief away from home, the paper's filters near it),
+        ``"bearings"`` (the pose belief weighed also by the landmarks' bearings) or any
         name given to :func:`register_tracker`; ``"package.module:factory"`` (imported,
         then called with no arguments: a spec that survives pickling into worker
         processes and the command line); a dict ``{"type": name, **kwargs}``

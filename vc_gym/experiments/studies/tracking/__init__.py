@@ -236,6 +236,7 @@ def run_tracking(
             spots=spots[scene],
             around_m=GRID_AROUND_M,
             keep_around=True,
+            learning={"landmarks": True},  # the bearings tracker's; no other tracker's
         )
         for scene in scenes
         for seed in seeds
