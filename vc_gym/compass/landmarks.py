@@ -36,6 +36,11 @@ MAX_LANDMARKS = 100_000
 _KEYS = ("positions", "pairs", "std_m", "support")
 
 
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """Angles (radians) wrapped to ``[-pi, pi)``."""
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
 def _check_camera_poses(xy: object, yaw_rad: object) -> tuple[np.ndarray, np.ndarray]:
     """``(N, 2)`` finite positions and ``(N,)`` finite directions, else a ``ValueError``."""
     xy_a = np.asarray(xy, dtype=np.float64)
@@ -164,27 +169,73 @@ class LandmarkMap:
             )
         half = math.radians(bearings.hfov_deg) / 2.0
         log_floor = math.log(outlier)
-        observed_pairs = bearings.pairs
+        # the candidates: every (change, landmark of its pair), grouped by change
+        order = np.argsort(self.pairs, kind="stable")
+        sorted_pairs = self.pairs[order]
+        observed = bearings.pairs
+        lo = np.searchsorted(sorted_pairs, observed, side="left")
+        count = np.searchsorted(sorted_pairs, observed, side="right") - lo
+        matched = count > 0
+        total += log_floor * int(np.count_nonzero(~matched))
+        if not matched.any():
+            return total
+        c = count[matched]
+        first = np.cumsum(c) - c  # where each change's candidates start
+        within = np.arange(int(c.sum())) - np.repeat(first, c)
+        landmark = order[np.repeat(lo[matched], c) + within]
+        change = np.repeat(np.flatnonzero(matched), c)
         offsets = np.radians(bearings.offsets_deg)
-        for pair in np.unique(observed_pairs):
-            k = observed_pairs == pair
-            m = self.pairs == pair
-            if not m.any():
-                total += log_floor * int(k.sum())
-                continue
-            d = self.positions[m][None, :, :] - eye_xy[:, None, :]  # (N, M, 2)
-            dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
-            predicted = np.angle(
-                np.exp(1j * (np.arctan2(d[..., 1], d[..., 0]) - camera_yaw_rad[:, None]))
-            )
-            sigma2 = noise_rad**2 + (self.std_m[m][None, :] / dist) ** 2  # (N, M)
-            # (N, K, M): every observed change against every landmark of its pair
-            err = np.angle(np.exp(1j * (offsets[k][None, :, None] - predicted[:, None, :])))
-            var = sigma2[:, None, :]
-            score = -0.5 * err**2 / var - 0.5 * np.log(var / noise_rad**2)
-            score = np.where(np.abs(predicted)[:, None, :] <= half, score, -np.inf)
-            total += np.logaddexp(score.max(axis=2), log_floor).sum(axis=1)
-        return total
+        # drop the candidates that miss by so much from every pose that their term is
+        # below the floor by more than e^20 (the answer changes by less than 1e-8)
+        keep = self._within_reach(landmark, offsets[change], eye_xy, camera_yaw_rad,
+                                  noise_rad, half, log_floor)  # fmt: skip
+        landmark, change = landmark[keep], change[keep]
+        changes, c = np.unique(change, return_counts=True)
+        total += log_floor * int(np.count_nonzero(matched) - changes.size)
+        if changes.size == 0:
+            return total
+        first = np.cumsum(c) - c
+        used, which = np.unique(landmark, return_inverse=True)
+        which = which.reshape(-1)
+        # every used landmark from every pose: (N, U)
+        d = self.positions[used][None, :, :] - eye_xy[:, None, :]
+        dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
+        predicted = _wrap(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw_rad[:, None])
+        var = noise_rad**2 + (self.std_m[used][None, :] / dist) ** 2
+        # every candidate from every pose: (N, C)
+        err = _wrap(offsets[change][None, :] - predicted[:, which])
+        var_c = var[:, which]
+        score = -0.5 * err**2 / var_c - 0.5 * np.log(var_c / noise_rad**2)
+        score = np.where(np.abs(predicted[:, which]) <= half, score, -np.inf)
+        best = np.maximum.reduceat(score, first, axis=1)  # (N, matched changes)
+        return total + np.logaddexp(best, log_floor).sum(axis=1)
+
+    def _within_reach(
+        self,
+        landmark: np.ndarray,
+        offset: np.ndarray,
+        eye_xy: np.ndarray,
+        camera_yaw_rad: np.ndarray,
+        noise_rad: float,
+        half: float,
+        log_floor: float,
+    ) -> np.ndarray:
+        """Which candidates ``(landmark, observed offset)`` may score within e^20 of the
+        floor from some pose: a bound from the poses' centre, their spread in direction
+        and in position (which turns a landmark's bearing by at most ``asin(r / d)``)."""
+        centre = eye_xy.mean(axis=0)
+        yaw = math.atan2(float(np.sin(camera_yaw_rad).sum()), float(np.cos(camera_yaw_rad).sum()))
+        turn = float(np.max(np.abs(_wrap(camera_yaw_rad - yaw))))
+        shift = float(np.max(np.hypot(*(eye_xy - centre).T)))
+        d = self.positions[landmark] - centre
+        dist = np.hypot(d[:, 0], d[:, 1])
+        near = np.maximum(dist - shift, 1e-9)
+        reach = turn + np.where(dist > shift, np.arcsin(np.minimum(shift / near, 1.0)), np.pi)
+        sigma = np.sqrt(noise_rad**2 + (self.std_m[landmark] / np.maximum(near, 0.05)) ** 2)
+        # a score below log_floor - 20 needs |err| > sqrt(2 (20 - log_floor)) sigma
+        gate = reach + math.sqrt(2.0 * (20.0 - log_floor)) * sigma
+        predicted = _wrap(np.arctan2(d[:, 1], d[:, 0]) - yaw)
+        return (np.abs(_wrap(offset - predicted)) <= gate) & (np.abs(predicted) <= half + reach)
 
     def to_arrays(self, prefix: str = "landmarks/") -> dict[str, np.ndarray]:
         """The map as plain arrays (for a map file), keys ``prefix + name``."""

@@ -52,6 +52,9 @@ class BearingTracker(PoseTracker):
         Added in quadrature to the particles' spread in the stated uncertainty (see
         :class:`PoseTracker`); smaller than the pose tracker's, because the bearings
         tell positions apart to centimetres.
+    outlier, motion_noise, n_particles
+        As :class:`PoseTracker`'s; a lower weight floor and a tighter motion noise than
+        its defaults: the bearings, not the motion noise, keep the cloud on the robot.
     **pose_options
         Any other :class:`PoseTracker` argument.
     """
@@ -60,12 +63,22 @@ class BearingTracker(PoseTracker):
         self,
         bearing_noise_deg: float = 0.5,
         bearing_outlier: float = 0.05,
-        bearing_temperature: float = 2.0,
-        resolution_m: float = 0.03,
-        resolution_deg: float = 0.5,
+        bearing_temperature: float = 1.0,
+        resolution_m: float = 0.015,
+        resolution_deg: float = 0.25,
+        outlier: float = 0.001,
+        motion_noise: tuple[float, float, float] = (0.005, 0.005, 0.5),
+        n_particles: int = 500,
         **pose_options: Any,
     ):
-        super().__init__(resolution_m=resolution_m, resolution_deg=resolution_deg, **pose_options)
+        super().__init__(
+            n_particles=n_particles,
+            resolution_m=resolution_m,
+            resolution_deg=resolution_deg,
+            outlier=outlier,
+            motion_noise=motion_noise,
+            **pose_options,
+        )
         self.bearing_noise_deg = positive_float("bearing_noise_deg", bearing_noise_deg)
         self.bearing_outlier = positive_float("bearing_outlier", bearing_outlier)
         if self.bearing_outlier >= 1.0:
