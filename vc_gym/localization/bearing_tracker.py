@@ -35,7 +35,10 @@ class BearingTracker(PoseTracker):
     :attr:`~vc_gym.compass.CompassAtlas.landmarks`) then weigh the same particles to a
     fraction of a degree per change: the fine pose. Their log-likelihood is divided by
     ``bearing_temperature`` (the changes of one frame are not independent either) and
-    added to the maps' before the outlier floor.
+    added to the maps' before the outlier floor. Their noise is ``bearing_noise_deg``
+    widened, in quadrature, by the spread of the cloud's core (its heading, and its
+    position seen from :data:`SPREAD_RANGE_M`): a broad cloud is sharpened step by step
+    instead of being taken over by the particle that happens to line up a few changes.
 
     An atlas without landmarks (learned without ``landmarks=True``) leaves the maps
     alone, with a warning: the tracker is then the pose tracker with its stated spread.
@@ -144,7 +147,7 @@ def _core_spread(particles: np.ndarray, weights: np.ndarray) -> tuple[float, flo
     heading (deg) and of their distance from the weighted mean position (m)."""
     theta = np.radians(particles[:, 2])
     mean = math.atan2(float(weights @ np.sin(theta)), float(weights @ np.cos(theta)))
-    off = np.degrees(np.abs(np.angle(np.exp(1j * (theta - mean)))))
+    off = np.degrees(np.abs((theta - mean + np.pi) % (2.0 * np.pi) - np.pi))
     centre = weights @ particles[:, :2]
     dist = np.hypot(*(particles[:, :2] - centre).T)
     return 1.4826 * _weighted_median(off, weights), 1.4826 * _weighted_median(dist, weights)
