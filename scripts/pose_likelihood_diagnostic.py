@@ -46,7 +46,7 @@ import numpy as np
 
 from vc_gym.angles import wrap180
 from vc_gym.compass import Camera, CompassAtlas
-from vc_gym.compass.bearings import frame_bearings
+from vc_gym.compass.bearings import bands_bearings
 from vc_gym.compass.landmarks import LearnedView, learn_landmarks
 from vc_gym.compass.parallax import ParallaxMap
 from vc_gym.compass.pose_maps import PoseMaps, around_groups
@@ -110,7 +110,7 @@ def bearing_sensor(room: AiboRoomEnv, atlas: CompassAtlas, camera: Camera) -> Be
             image, cam, (ex, ey, eye_yaw), _ = frame_at_pose(
                 room, camera, float(x), float(y), float(yaw)
             )
-            views.append(LearnedView(frame_bearings(image, cam, colors), eye_yaw, ex, ey))
+            views.append(LearnedView(bands_bearings(image, cam, colors), eye_yaw, ex, ey))
     landmarks = learn_landmarks(views)
     print(f"{len(landmarks)} landmarks from {len(views)} learning frames "
           f"(median uncertainty {np.median(landmarks.std_m):.3f} m)")
@@ -119,7 +119,7 @@ def bearing_sensor(room: AiboRoomEnv, atlas: CompassAtlas, camera: Camera) -> Be
 
 def bearing_scores(sensor, image, camera, pitch, xy, body_heading, pan) -> np.ndarray:
     """``(cells, headings)`` log-likelihoods of the grid from the frame's bearings."""
-    found = frame_bearings(image, camera.replace(pitch_deg=pitch), sensor.colors)
+    found = bands_bearings(image, camera.replace(pitch_deg=pitch), sensor.colors)
     poses = np.column_stack([np.repeat(xy, len(body_heading), axis=0),
                              np.tile(body_heading, len(xy))])
     return sensor.pose_log_likelihood(found, poses, pan).reshape(len(xy), len(body_heading))

@@ -5,10 +5,10 @@ the four spots 1 m around it, each with the turns 0.5 m around it, every 30°); 
 colour changes are triangulated into landmarks
 (:func:`~vc_gym.compass.landmarks.learn_landmarks`). Frames from seeded random
 poses of the field are rendered once; each round then reads every frame's changes
-(:func:`~vc_gym.compass.bearings.frame_bearings`) and scores ``poses`` candidate poses
-around the truth (:class:`~vc_gym.localization.bearing_sensor.BearingSensor`). The
-medians over the rounds are reported per frame, with the landmarks' count and the
-changes a frame shows.
+(:func:`~vc_gym.compass.bearings.bands_bearings`, the default bands) and scores
+``poses`` candidate poses around the truth
+(:class:`~vc_gym.localization.bearing_sensor.BearingSensor`). The medians over the
+rounds are reported per frame, with the landmarks' count and the changes a frame shows.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 from tqdm import tqdm
 
 from vc_gym.compass import Camera
-from vc_gym.compass.bearings import frame_bearings
+from vc_gym.compass.bearings import bands_bearings
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.landmarks import LearnedView, learn_landmarks
 from vc_gym.localization.bearing_sensor import BearingSensor
@@ -99,7 +99,7 @@ def bench_bearings(
         ]
         colors = ColorClasses.fit([t[0] for t in turns[::4]], rng=np.random.default_rng(seed))
         views = [
-            LearnedView(frame_bearings(image, cam, colors), eye[2], eye[0], eye[1])
+            LearnedView(bands_bearings(image, cam, colors), eye[2], eye[0], eye[1])
             for image, cam, eye, _ in turns
         ]
         sensor = BearingSensor(
@@ -122,7 +122,7 @@ def bench_bearings(
         t_read = t_score = 0.0
         for image, cam, near in tests:
             t0 = time.perf_counter()
-            found = frame_bearings(image, cam, colors)
+            found = bands_bearings(image, cam, colors)
             t1 = time.perf_counter()
             sensor.pose_log_likelihood(found, near)
             t_score += time.perf_counter() - t1
