@@ -12,6 +12,7 @@ from vc_gym.angles import (
     interp_circular,
     wrap180,
     wrap360,
+    wrap_pi,
 )
 
 angles = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False)
@@ -22,6 +23,14 @@ def test_wrap180_range_and_congruence(a):
     w = wrap180(a)
     assert -180.0 <= w < 180.0
     assert math.isclose(math.remainder(w - a, 360.0), 0.0, abs_tol=1e-6)
+
+
+@given(angles)
+def test_wrap_pi_range_and_congruence(a):
+    w = wrap_pi(a)
+    assert -math.pi <= w < math.pi
+    assert math.isclose(math.remainder(w - a, 2 * math.pi), 0.0, abs_tol=1e-6)
+    assert wrap_pi(np.array([a])).shape == (1,)  # arrays stay arrays
 
 
 @given(angles)

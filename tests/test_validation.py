@@ -11,6 +11,7 @@ from vc_gym.validation import (
     int_at_least,
     nonnegative_float,
     nonnegative_float_at_most,
+    open_fraction,
     positive_float,
     positive_float_at_most,
 )
@@ -40,6 +41,18 @@ def test_out_of_range_values_are_refused(check, value):
 def test_non_numbers_are_refused(check, value):
     with pytest.raises(ValueError, match="time_s must be a real number"):
         check("time_s", value)
+
+
+def test_open_fraction_is_neither_impossible_nor_certain():
+    assert open_fraction("p", 0.05) == 0.05
+    for value in (0.0, -0.1, float("nan")):
+        with pytest.raises(ValueError, match="p must be finite and > 0"):
+            open_fraction("p", value)
+    for value in (1.0, 1.5, float("inf")):
+        with pytest.raises(ValueError, match="p must be"):
+            open_fraction("p", value)
+    with pytest.raises(ValueError, match=r"p must be in \(0, 1\), got 1.0"):
+        open_fraction("p", 1.0)
 
 
 def test_finite_float_converts_and_refuses():

@@ -17,6 +17,7 @@ __all__ = [
     "steps_in_circle",
     "wrap180",
     "wrap360",
+    "wrap_pi",
     "circular_mean",
     "circular_std",
     "circular_std_rows",
@@ -64,6 +65,15 @@ def wrap180(angle_deg: ArrayLike) -> np.ndarray | float:
     out = np.mod(a + 180.0, 360.0) - 180.0
     # mod of a tiny negative number can round up to exactly 360 -> 180; keep [-180, 180)
     out = np.where(out >= 180.0, out - 360.0, out)
+    return float(out) if out.ndim == 0 else out
+
+
+def wrap_pi(angle_rad: ArrayLike) -> np.ndarray | float:
+    """Wrap angles in radians to ``[-pi, pi)`` (:func:`wrap180` for radians, for the
+    hot paths that work in radians)."""
+    a = np.asarray(angle_rad, dtype=float)
+    out = np.mod(a + np.pi, 2.0 * np.pi) - np.pi
+    out = np.where(out >= np.pi, out - 2.0 * np.pi, out)
     return float(out) if out.ndim == 0 else out
 
 

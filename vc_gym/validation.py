@@ -101,6 +101,15 @@ def positive_float(name: str, value: object) -> float:
     return v
 
 
+def open_fraction(name: str, value: object) -> float:
+    """``float(value)`` if it is a real number in ``(0, 1)`` (a probability that must
+    be neither impossible nor certain), else a ``ValueError``."""
+    v = positive_float(name, value)
+    if v >= 1.0:
+        raise ValueError(f"{name} must be in (0, 1), got {value!r}")
+    return v
+
+
 def nonnegative_float(name: str, value: object) -> float:
     """``float(value)`` if it is a finite real number >= 0, else a ``ValueError``."""
     v = _real(name, value)

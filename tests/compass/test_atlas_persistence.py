@@ -98,6 +98,7 @@ def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
     assert loaded.pairs.tolist()[0] == 3 and loaded.support.tolist() == [4, 7]
     assert loaded.n_colors == room_atlas.compasses[0].config.n_colors
     assert loaded.eye_forward_m == 0.25  # where the camera sat: the sensor's too
+    assert loaded.bands == ((0.5, 4.0),)  # the bands its changes were read in
 
 
 @pytest.mark.parametrize(
@@ -112,6 +113,10 @@ def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
         ({"std_m": np.array([0.1])}, "count"),
         ({"eye_forward_m": 5.0}, "eye_forward_m"),
         ({"eye_forward_m": float("nan")}, "eye_forward_m"),
+        ({"bands": ((4.0, 1.0),)}, "band"),
+        ({"bands": ((0.5, float("nan")),)}, "band"),
+        ({"bands": ()}, "bands must number"),
+        ({"bands": ((0.5, 4.0),) * 17}, "bands must number"),
     ],
 )
 def test_bad_landmarks_in_a_file_are_refused(room_atlas, tmp_path, changes, message):

@@ -153,7 +153,8 @@ def bands_bearings(
 
 
 def _band_rows(camera: Camera, width: int, height: int, band_deg: tuple[float, float]) -> slice:
-    lo, hi = check_band(band_deg)
+    """The image rows of ``band_deg`` (checked by the caller)."""
+    lo, hi = band_deg
     f = camera.focal_px(width)
     horizon = camera.horizon_row(width, height)
     top = horizon - f * math.tan(math.radians(hi))
@@ -200,9 +201,9 @@ def frame_bearings(
     int_at_least("max_gap_px", max_gap_px, 0)
     height, width = img.shape[:2]
     n = colors.n_colors
-    rows = _band_rows(camera, width, height, band_deg)
-    empty = np.zeros(0, np.int64)
     band = (check_band(band_deg),)
+    rows = _band_rows(camera, width, height, band[0])
+    empty = np.zeros(0, np.int64)
     if rows.stop - rows.start < 1:
         return FrameBearings(np.zeros(0), empty, empty, n, camera.hfov_deg, bands=band)
     classes = colors.classify(img[rows]).astype(np.int64)  # (R, W)

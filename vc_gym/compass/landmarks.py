@@ -18,8 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vc_gym.angles import wrap_pi
 from vc_gym.compass.bearings import DEFAULT_BAND_DEG, MAX_BANDS, FrameBearings, check_bands
-from vc_gym.validation import MAX_ABS_METRES, finite_float, int_at_least, positive_float
+from vc_gym.validation import (
+    MAX_ABS_METRES,
+    finite_float,
+    int_at_least,
+    open_fraction,
+    positive_float,
+)
 
 __all__ = [
     "MAX_CANDIDATES",
@@ -34,11 +41,6 @@ __all__ = [
 MAX_LANDMARKS = 100_000
 #: The entries of a landmark map in a map file (see :meth:`LandmarkMap.to_arrays`).
 _KEYS = ("positions", "pairs", "std_m", "support")
-
-
-def _wrap(a: np.ndarray) -> np.ndarray:
-    """Angles (radians) wrapped to ``[-pi, pi)``."""
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def _check_camera_poses(xy: object, yaw_rad: object) -> tuple[np.ndarray, np.ndarray]:
@@ -156,9 +158,7 @@ class LandmarkMap:
         """
         eye_xy, camera_yaw_rad = _check_camera_poses(eye_xy, camera_yaw_rad)
         noise_rad = positive_float("noise_rad", noise_rad)
-        outlier = positive_float("outlier", outlier)
-        if outlier >= 1.0:
-            raise ValueError(f"outlier must be in (0, 1), got {outlier}")
+        outlier = open_fraction("outlier", outlier)
         total = np.zeros(len(eye_xy))
         if len(bearings) == 0:
             return total
@@ -200,10 +200,10 @@ class LandmarkMap:
         # every used landmark from every pose: (N, U)
         d = self.positions[used][None, :, :] - eye_xy[:, None, :]
         dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
-        predicted = _wrap(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw_rad[:, None])
+        predicted = wrap_pi(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw_rad[:, None])
         var = noise_rad**2 + (self.std_m[used][None, :] / dist) ** 2
         # every candidate from every pose: (N, C)
-        err = _wrap(offsets[change][None, :] - predicted[:, which])
+        err = wrap_pi(offsets[change][None, :] - predicted[:, which])
         var_c = var[:, which]
         score = -0.5 * err**2 / var_c - 0.5 * np.log(var_c / noise_rad**2)
         score = np.where(np.abs(predicted[:, which]) <= half, score, -np.inf)
@@ -225,7 +225,7 @@ class LandmarkMap:
         and in position (which turns a landmark's bearing by at most ``asin(r / d)``)."""
         centre = eye_xy.mean(axis=0)
         yaw = math.atan2(float(np.sin(camera_yaw_rad).sum()), float(np.cos(camera_yaw_rad).sum()))
-        turn = float(np.max(np.abs(_wrap(camera_yaw_rad - yaw))))
+        turn = float(np.max(np.abs(wrap_pi(camera_yaw_rad - yaw))))
         shift = float(np.max(np.hypot(*(eye_xy - centre).T)))
         d = self.positions[landmark] - centre
         dist = np.hypot(d[:, 0], d[:, 1])
@@ -234,8 +234,8 @@ class LandmarkMap:
         sigma = np.sqrt(noise_rad**2 + (self.std_m[landmark] / np.maximum(near, 0.05)) ** 2)
         # a score below log_floor - 20 needs |err| > sqrt(2 (20 - log_floor)) sigma
         gate = reach + math.sqrt(2.0 * (20.0 - log_floor)) * sigma
-        predicted = _wrap(np.arctan2(d[:, 1], d[:, 0]) - yaw)
-        return (np.abs(_wrap(offset - predicted)) <= gate) & (np.abs(predicted) <= half + reach)
+        predicted = wrap_pi(np.arctan2(d[:, 1], d[:, 0]) - yaw)
+        return (np.abs(wrap_pi(offset - predicted)) <= gate) & (np.abs(predicted) <= half + reach)
 
     def to_arrays(self, prefix: str = "landmarks/") -> dict[str, np.ndarray]:
         """The map as plain arrays (for a map file), keys ``prefix + name``."""
@@ -384,7 +384,7 @@ def _best_candidate(
     for start in range(0, len(points), chunk):
         p = points[start : start + chunk]
         to = p[:, None, :] - o[None, :, :]
-        miss = np.angle(np.exp(1j * (np.arctan2(to[..., 1], to[..., 0]) - a[None])))
+        miss = wrap_pi(np.arctan2(to[..., 1], to[..., 0]) - a[None])
         sees = np.abs(miss) < tol
         rows, cols = np.nonzero(sees)
         seen_from = np.zeros((len(p), n_pos), bool)

@@ -17,8 +17,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from vc_gym.angles import wrap_pi
 from vc_gym.compass.bearings import FrameBearings
 from vc_gym.compass.landmarks import LandmarkMap, LearnedView, eye_positions, learn_landmarks
+from vc_gym.poses import body_to_world
 from vc_gym.validation import finite_float, int_at_least, positive_float
 
 __all__ = [
@@ -157,10 +159,6 @@ def _grid(
     return np.asarray(centre, np.float64) + offsets
 
 
-def _wrap(a: np.ndarray) -> np.ndarray:
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
-
-
 def _walk_sigmas(walk: tuple[float, float, float]) -> tuple[float, float]:
     """σ of a walk's end position (m) and heading (deg)."""
     return (
@@ -174,12 +172,8 @@ def _chained(
 ) -> tuple[float, float, float]:
     """Where the odometry's ``walk`` puts the body, from ``previous``'s last frame."""
     x, y, yaw = previous.last_pose(tuple(float(e) for e in correction))
-    t = math.radians(yaw)
-    return (
-        x + walk[0] * math.cos(t) - walk[1] * math.sin(t),
-        y + walk[0] * math.sin(t) + walk[1] * math.cos(t),
-        yaw + walk[2],
-    )
+    dx, dy = body_to_world(walk[0], walk[1], yaw)
+    return x + dx, y + dy, yaw + walk[2]
 
 
 @dataclass(frozen=True)
@@ -233,7 +227,7 @@ class _Walks:
             jac[3 * i : 3 * i + 2, n - 1] = along / sp
             fx, fy = gain * fx, gain * fy
             r[3 * i : 3 * i + 2] = (end - where[k] - cor[k, :2]) / sp
-            r[3 * i + 2] = _wrap(psi + fyaw - self.first[i] - cor[k, 2]) / sy
+            r[3 * i + 2] = wrap_pi(psi + fyaw - self.first[i] - cor[k, 2]) / sy
             turn_cols = 4 * k
             jac[3 * i, turn_cols] = jac[3 * i + 1, turn_cols + 1] = -1.0 / sp
             jac[3 * i + 2, turn_cols + 2] = -1.0 / sy
@@ -292,11 +286,7 @@ def _camera(
     ``(T, 4)`` with headings in radians."""
     cor = corrections[c.turn]
     body_yaw = c.first + cor[:, 2] + c.rel * cor[:, 3]
-    eye = (
-        where[c.turn]
-        + cor[:, :2]
-        + eye_forward_m * np.stack([np.cos(body_yaw), np.sin(body_yaw)], axis=1)
-    )
+    eye = eye_positions(where[c.turn] + cor[:, :2], body_yaw, eye_forward_m)
     return eye, body_yaw, body_yaw + c.pan
 
 
@@ -318,8 +308,8 @@ def _associate(
     for s in range(0, len(out), chunk):
         sl = slice(s, s + chunk)
         d = positions[None] - eye[sl, None]
-        predicted = _wrap(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw[sl, None])
-        miss = np.abs(_wrap(c.offset[sl, None] - predicted))
+        predicted = wrap_pi(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw[sl, None])
+        miss = np.abs(wrap_pi(c.offset[sl, None] - predicted))
         ok = (pairs[None] == c.pair[sl, None]) & (np.abs(predicted) <= half_fov)
         miss = np.where(ok, miss, np.inf)
         j = np.argmin(miss, axis=1)
@@ -477,7 +467,7 @@ def _levenberg_marquardt(
         eye, body_yaw, cam = _camera(where, cr, c, eye_forward_m)
         d = pts[lm] - eye
         q = np.maximum(np.sum(d**2, axis=1), 1e-4)
-        r = _wrap(c.offset - np.arctan2(d[:, 1], d[:, 0]) + cam) / noise
+        r = wrap_pi(c.offset - np.arctan2(d[:, 1], d[:, 0]) + cam) / noise
         d_yaw = 1.0 + eye_forward_m * (d[:, 0] * np.cos(body_yaw) + d[:, 1] * np.sin(body_yaw)) / q
         jac = np.stack(
             [-d[:, 1] / q, d[:, 0] / q, d_yaw, c.rel * d_yaw, d[:, 1] / q, -d[:, 0] / q], axis=1

@@ -21,7 +21,7 @@ from vc_gym.compass import Camera
 from vc_gym.errors import NotLearnedError
 from vc_gym.heading_sensors.base import BaselineCompass, FrameScore, check_camera
 from vc_gym.images import check_image
-from vc_gym.validation import int_at_least, int_in_range, positive_float
+from vc_gym.validation import int_at_least, int_in_range, open_fraction, positive_float
 
 __all__ = ["FeatureCompass", "keypoint_directions"]
 
@@ -219,9 +219,7 @@ class FeatureCompass(BaselineCompass):
         self.sigma_deg = positive_float("sigma_deg", sigma_deg)
         if self.sigma_deg > 90.0:
             raise ValueError(f"sigma_deg must be <= 90, got {sigma_deg}")
-        self.outlier_prob = positive_float("outlier_prob", outlier_prob)
-        if self.outlier_prob >= 1.0:
-            raise ValueError(f"outlier_prob must be in (0, 1), got {outlier_prob}")
+        self.outlier_prob = open_fraction("outlier_prob", outlier_prob)
         self.max_elevation_diff_deg = positive_float(
             "max_elevation_diff_deg", max_elevation_diff_deg
         )

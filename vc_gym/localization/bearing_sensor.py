@@ -25,7 +25,7 @@ from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
 from vc_gym.compass.landmarks import LandmarkMap, eye_positions
 from vc_gym.filters.sensor_protocol import check_pose_query
-from vc_gym.validation import finite_float, positive_float
+from vc_gym.validation import finite_float, open_fraction, positive_float
 
 __all__ = ["BearingSensor"]
 
@@ -72,10 +72,7 @@ class BearingSensor:
         self.colors = colors
         self.camera = Camera() if camera is None else camera
         self.noise_deg = positive_float("noise_deg", noise_deg)
-        outlier = positive_float("outlier", outlier)
-        if outlier >= 1.0:
-            raise ValueError(f"outlier must be in (0, 1), got {outlier}")
-        self.outlier = outlier
+        self.outlier = open_fraction("outlier", outlier)
         if eye_forward_m is None:
             eye_forward_m = landmarks.eye_forward_m
         self.eye_forward_m = finite_float("eye_forward_m", eye_forward_m)

@@ -9,12 +9,13 @@ from typing import Any
 
 import numpy as np
 
+from vc_gym.angles import circular_mean, wrap180
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.compass.bearings import FrameBearings
 from vc_gym.localization.bearing_sensor import BearingSensor
 from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import TrackerState
-from vc_gym.validation import positive_float
+from vc_gym.validation import open_fraction, positive_float
 
 __all__ = ["SPREAD_RANGE_M", "BearingTracker"]
 
@@ -83,9 +84,7 @@ class BearingTracker(PoseTracker):
             **pose_options,
         )
         self.bearing_noise_deg = positive_float("bearing_noise_deg", bearing_noise_deg)
-        self.bearing_outlier = positive_float("bearing_outlier", bearing_outlier)
-        if self.bearing_outlier >= 1.0:
-            raise ValueError(f"bearing_outlier must be in (0, 1), got {bearing_outlier!r}")
+        self.bearing_outlier = open_fraction("bearing_outlier", bearing_outlier)
         self.bearing_temperature = positive_float("bearing_temperature", bearing_temperature)
         self.sensor: BearingSensor | None = None
         self._changes: FrameBearings | None = None
@@ -145,9 +144,7 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
 def _core_spread(particles: np.ndarray, weights: np.ndarray) -> tuple[float, float]:
     """Robust σ (1.4826 × the weighted median absolute deviation) of the particles'
     heading (deg) and of their distance from the weighted mean position (m)."""
-    theta = np.radians(particles[:, 2])
-    mean = math.atan2(float(weights @ np.sin(theta)), float(weights @ np.cos(theta)))
-    off = np.degrees(np.abs((theta - mean + np.pi) % (2.0 * np.pi) - np.pi))
+    off = np.abs(wrap180(particles[:, 2] - circular_mean(particles[:, 2], weights)))
     centre = weights @ particles[:, :2]
     dist = np.hypot(*(particles[:, :2] - centre).T)
     return 1.4826 * _weighted_median(off, weights), 1.4826 * _weighted_median(dist, weights)
