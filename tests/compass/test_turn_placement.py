@@ -14,6 +14,8 @@ from vc_gym.compass.landmarks import learn_landmarks
 from vc_gym.compass.turn_placement import (
     NO_CORRECTION,
     LearnedTurn,
+    _normal_equations,
+    _schur_step,
     adjust_turns,
     place_turns,
 )
@@ -117,3 +119,28 @@ def test_a_turn_with_no_frames_or_a_map_with_no_landmarks_is_left_alone(drifted)
     out, positions = adjust_turns(turns[:2], nothing, corrections, eye_forward_m=AHEAD)
     np.testing.assert_array_equal(out, corrections)
     assert positions.shape == (0, 2)
+
+
+def test_the_adjustment_step_eliminating_the_points_is_the_dense_solve():
+    """The blocks of the normal equations and the step that eliminates the points give
+    what the whole system, built residual by residual and solved densely, gives."""
+    rng = np.random.default_rng(0)
+    n_turns, n_points, n_res = 5, 7, 200
+    turn, lm = rng.integers(0, n_turns, n_res), rng.integers(0, n_points, n_res)
+    t_cols = 4 * turn[:, None] + np.arange(4)
+    jac, r = rng.normal(size=(n_res, 6)), rng.normal(size=n_res)
+    w = rng.uniform(0.2, 1.0, n_res)
+    n_t = 4 * n_turns + 1  # the gain's column last
+    a, b, d, g_t, g_p = _normal_equations(t_cols, lm, jac, w, r, n_t, n_points)
+    a[-1, -1] += 1.0  # the gain's prior
+    n = n_t + 2 * n_points
+    cols = np.concatenate([t_cols, n_t + 2 * lm[:, None] + np.arange(2)], axis=1)
+    h, g = np.zeros((n, n)), np.zeros(n)
+    for k in range(n_res):
+        h[np.ix_(cols[k], cols[k])] += w[k] * np.outer(jac[k], jac[k])
+        g[cols[k]] += w[k] * r[k] * jac[k]
+    h[n_t - 1, n_t - 1] += 1.0
+    for damping in (1e-3, 1.0):
+        x = np.linalg.solve(h + damping * np.diag(np.diag(h) + 1e-9), -g)
+        x_t, x_p = _schur_step(a, b, d, g_t, g_p, damping)
+        assert np.allclose(x_t, x[:n_t], atol=1e-12) and np.allclose(x_p, x[n_t:], atol=1e-12)

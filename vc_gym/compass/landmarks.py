@@ -331,32 +331,33 @@ def _merge_repeats(o: np.ndarray, a: np.ndarray, merge: float) -> tuple[np.ndarr
     keys = np.round(o / 0.01).astype(np.int64)
     _, group = np.unique(keys, axis=0, return_inverse=True)
     group = group.reshape(-1)
-    out_o, out_a = [], []
-    for g in np.unique(group):
-        idx = np.flatnonzero(group == g)
-        order = idx[np.argsort(a[idx])]
-        angles = a[order]
-        cuts = np.flatnonzero(np.diff(angles) > merge) + 1
-        for run in np.split(np.arange(len(order)), cuts):
-            out_o.append(o[order[run]].mean(axis=0))
-            out_a.append(float(np.angle(np.mean(np.exp(1j * angles[run])))))
-    return np.asarray(out_o, np.float64).reshape(-1, 2), np.asarray(out_a, np.float64)
+    order = np.lexsort((a, group))
+    g, angles = group[order], a[order]
+    # a run ends where the viewpoint changes or the next bearing is more than merge on
+    starts = np.flatnonzero(np.r_[True, (np.diff(g) != 0) | (np.diff(angles) > merge)])
+    counts = np.diff(np.r_[starts, len(order)])
+    origins = np.add.reduceat(o[order], starts, axis=0) / counts[:, None]
+    mean_angle = np.angle(np.add.reduceat(np.exp(1j * angles), starts))
+    return origins.astype(np.float64).reshape(-1, 2), mean_angle.astype(np.float64)
 
 
-#: Most candidate crossings scored per landmark found (pairs of rays beyond this are
-#: drawn at random, seeded): bounds the memory and time a map with many rays needs.
+#: Most candidate crossings drawn at once for one colour pair (pairs of rays beyond
+#: this are drawn at random, seeded, and drawn again once those are used up): bounds
+#: the memory and time a map with many rays needs.
 MAX_CANDIDATES = 20_000
-#: Most candidate x ray entries scored at once.
+#: Most candidate x ray entries tested at once.
 _CHUNK = 2_000_000
 
 
 def _intersections(
     o: np.ndarray, a: np.ndarray, min_angle: float, max_range: float, rng: np.random.Generator
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """Points where two rays of different origins cross in front of both (at most
-    :data:`MAX_CANDIDATES` pairs of rays, drawn at random when there are more)."""
+    :data:`MAX_CANDIDATES` pairs of rays, drawn at random when there are more): the
+    points, the two rays of each and whether they were drawn."""
     n = len(a)
-    if n * (n - 1) // 2 <= MAX_CANDIDATES:
+    drawn = n * (n - 1) // 2 > MAX_CANDIDATES
+    if not drawn:
         i, j = np.triu_indices(n, k=1)
     else:
         i, j = rng.integers(0, n, (2, MAX_CANDIDATES))
@@ -370,30 +371,83 @@ def _intersections(
     t = (w[:, 0] * d[j, 1] - w[:, 1] * d[j, 0]) / cross
     s = (w[:, 0] * d[i, 1] - w[:, 1] * d[i, 0]) / cross
     front = (t > 0.05) & (s > 0.05) & (t < max_range) & (s < max_range)
-    return o[i[front]] + t[front, None] * d[i[front]]
+    i, j, t = i[front], j[front], t[front]
+    return o[i] + t[:, None] * d[i], i, j, drawn
 
 
-def _best_candidate(
-    points: np.ndarray, o: np.ndarray, a: np.ndarray, where: np.ndarray, tol: float
-) -> tuple[int, np.ndarray]:
-    """Of the candidates, the one seen by rays of the most distinct positions: that count
-    and which rays see it (angle to it within ``tol``); scored in chunks."""
-    n_pos = int(where.max()) + 1
-    chunk = max(1, _CHUNK // max(len(a), n_pos))
-    best_support, best_sees = -1, np.zeros(len(a), bool)
+def _sightings(points: np.ndarray, o: np.ndarray, a: np.ndarray, tol: float) -> tuple:
+    """Which rays see which points (the angle between the ray and the direction from its
+    origin to the point below ``tol``, tested without trigonometry), in chunks: the
+    ``(point, ray)`` index pairs, sorted by point."""
+    # single precision: a centimetre in a room is far above its rounding
+    dx, dy = np.cos(a).astype(np.float32), np.sin(a).astype(np.float32)
+    ox, oy = o[:, 0].astype(np.float32), o[:, 1].astype(np.float32)
+    tan_tol = np.float32(math.tan(tol))
+    chunk = max(1, _CHUNK // max(len(a), 1))
+    rows, cols = [], []
     for start in range(0, len(points), chunk):
-        p = points[start : start + chunk]
-        to = p[:, None, :] - o[None, :, :]
-        miss = wrap_pi(np.arctan2(to[..., 1], to[..., 0]) - a[None])
-        sees = np.abs(miss) < tol
-        rows, cols = np.nonzero(sees)
-        seen_from = np.zeros((len(p), n_pos), bool)
-        seen_from[rows, where[cols]] = True
-        support = seen_from.sum(axis=1)
-        k = int(np.argmax(support))
-        if support[k] > best_support:
-            best_support, best_sees = int(support[k]), sees[k]
-    return best_support, best_sees
+        p = points[start : start + chunk].astype(np.float32)
+        tx = p[:, 0:1] - ox[None, :]
+        ty = p[:, 1:2] - oy[None, :]
+        along = tx * dx + ty * dy
+        r, c = np.nonzero((along > 0) & (np.abs(tx * dy - ty * dx) < tan_tol * along))
+        rows.append(r + start)
+        cols.append(c)
+    return np.concatenate(rows), np.concatenate(cols)
+
+
+def _gather(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """The indices of every range ``[starts[k], ends[k])``, concatenated."""
+    lengths = ends - starts
+    offsets = np.cumsum(lengths) - lengths
+    return np.arange(int(lengths.sum())) - np.repeat(offsets - starts, lengths)
+
+
+def _greedy_round(
+    points: np.ndarray,
+    makers: tuple[np.ndarray, np.ndarray],
+    o: np.ndarray,
+    a: np.ndarray,
+    where: np.ndarray,
+    free: np.ndarray,
+    tol: float,
+    min_positions: int,
+) -> list[tuple[int, np.ndarray]]:
+    """Take, while one is seen from ``min_positions`` distinct positions, the candidate
+    seen from the most (by the rays still ``free``, which it then uses up); a candidate
+    made by a used ray is dropped. Returns each taken candidate's support and rays.
+
+    The sightings are found once; taking a candidate only updates the counts of the
+    candidates that shared its rays."""
+    idx = np.flatnonzero(free)
+    cand, col = _sightings(points, o[idx], a[idx], tol)
+    ray = idx[col]
+    n_pos = int(where.max()) + 1
+    units, unit_of = np.unique(cand * n_pos + where[ray], return_inverse=True)
+    unit_of = unit_of.reshape(-1)
+    rays_in_unit = np.bincount(unit_of, minlength=len(units))
+    unit_cand = units // n_pos
+    support = np.bincount(unit_cand, minlength=len(points))
+    cand_start = np.searchsorted(cand, np.arange(len(points) + 1))
+    by_ray = np.argsort(ray, kind="stable")
+    ray_start = np.searchsorted(ray[by_ray], np.arange(len(a) + 1))
+    dead = np.zeros(len(points), bool)
+    taken = []
+    while True:
+        k = int(np.argmax(np.where(dead, -1, support)))
+        if dead[k] or support[k] < min_positions:
+            return taken
+        rays = ray[cand_start[k] : cand_start[k + 1]]
+        rays = rays[free[rays]]
+        taken.append((int(support[k]), rays))
+        free[rays] = False
+        entries = by_ray[_gather(ray_start[rays], ray_start[rays + 1])]
+        hit = unit_of[entries]
+        np.subtract.at(rays_in_unit, hit, 1)
+        emptied = np.sort(hit[rays_in_unit[hit] == 0])  # each emptied unit once
+        emptied = emptied[np.r_[True, emptied[1:] != emptied[:-1]]]
+        np.subtract.at(support, unit_cand[emptied], 1)
+        dead |= ~free[makers[0]] | ~free[makers[1]]
 
 
 def _fit(o: np.ndarray, a: np.ndarray, floor_rad: float) -> tuple[np.ndarray, float]:
@@ -467,16 +521,16 @@ def learn_landmarks(
         free = np.ones(len(a), bool)
         while free.sum() >= min_positions:
             idx = np.flatnonzero(free)
-            points = _intersections(o[idx], a[idx], min_angle, max_range, rng)
+            points, i, j, drawn = _intersections(o[idx], a[idx], min_angle, max_range, rng)
             if len(points) == 0:
                 break
-            support, sees = _best_candidate(points, o[idx], a[idx], where[idx], tol)
-            if support < min_positions:
+            taken = _greedy_round(points, (idx[i], idx[j]), o, a, where, free, tol, min_positions)
+            for support, rays in taken:
+                point, std = _fit(o[rays], a[rays], floor)
+                found.append((point, int(pair), std, support))
+            # every pair of free rays was a candidate: none is left; drawn ones: draw again
+            if not drawn or not taken:
                 break
-            rays = idx[sees]
-            point, std = _fit(o[rays], a[rays], floor)
-            found.append((point, int(pair), std, support))
-            free[rays] = False
     if not found:
         none = np.zeros(0, np.int64)
         return LandmarkMap(np.zeros((0, 2)), none, np.zeros(0), none, n_colors, bands=bands)

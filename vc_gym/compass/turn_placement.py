@@ -300,21 +300,30 @@ def _associate(
     half_fov: float,
 ) -> np.ndarray:
     """Per change, the landmark of its colour pair whose predicted bearing is nearest,
-    within ``gate_rad`` and in view; -1 for none (in chunks of changes)."""
+    within ``gate_rad`` and in view; -1 for none (pair by pair, in chunks of changes)."""
     out = np.full(len(c.pair), -1, np.int64)
     if len(positions) == 0:
         return out
-    chunk = max(1, 4_000_000 // len(positions))
-    for s in range(0, len(out), chunk):
-        sl = slice(s, s + chunk)
-        d = positions[None] - eye[sl, None]
-        predicted = wrap_pi(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw[sl, None])
-        miss = np.abs(wrap_pi(c.offset[sl, None] - predicted))
-        ok = (pairs[None] == c.pair[sl, None]) & (np.abs(predicted) <= half_fov)
-        miss = np.where(ok, miss, np.inf)
-        j = np.argmin(miss, axis=1)
-        hit = miss[np.arange(len(j)), j] < gate_rad
-        out[sl] = np.where(hit, j, -1)
+    by_pair = np.argsort(pairs, kind="stable")
+    sorted_pairs = pairs[by_pair]
+    changes = np.argsort(c.pair, kind="stable")
+    codes, starts = np.unique(c.pair[changes], return_index=True)
+    ends = np.r_[starts[1:], len(changes)]
+    for code, first, last in zip(codes, starts, ends, strict=True):
+        lo, hi = np.searchsorted(sorted_pairs, [code, code + 1])
+        if lo == hi:
+            continue
+        cand = by_pair[lo:hi]  # ascending: ties go to the lowest index
+        chunk = max(1, 4_000_000 // len(cand))
+        for s in range(first, last, chunk):
+            sl = changes[s : min(s + chunk, last)]
+            d = positions[cand][None] - eye[sl, None]
+            predicted = wrap_pi(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw[sl, None])
+            miss = np.abs(wrap_pi(c.offset[sl, None] - predicted))
+            miss = np.where(np.abs(predicted) <= half_fov, miss, np.inf)
+            j = np.argmin(miss, axis=1)
+            hit = miss[np.arange(len(j)), j] < gate_rad
+            out[sl] = np.where(hit, cand[j], -1)
     return out
 
 
@@ -458,9 +467,7 @@ def _levenberg_marquardt(
     of the odometry's walk lengths."""
     n_turns = len(cor)
     n_turn, n = 4 * n_turns, 4 * n_turns + 2 * len(points) + 1
-    # the columns each residual touches (n: a dummy column, never used)
-    t_cols = 4 * c.turn[:, None] + np.arange(4)
-    cols = np.concatenate([t_cols, n_turn + 2 * lm[:, None] + np.arange(2)], axis=1)
+    t_cols = 4 * c.turn[:, None] + np.arange(4)  # the turn columns each residual touches
     scale_cols = 4 * np.arange(n_turns) + 3
 
     def residuals(cr: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -503,28 +510,27 @@ def _levenberg_marquardt(
             [1.0 / WALK_GAIN_SIGMA],
         ]
     )
+    # the turns' columns and the gain's (the rest are the points', 2 each)
+    t_side = np.r_[np.arange(n_turn), n - 1]
+    prior_at = np.searchsorted(t_side, prior_cols)
     damping = 1e-3
     cost = total_cost(cor, points, walk_gain)
     for _ in range(max_steps):
         r, jac = residuals(cor, points)
         _, w = _huber(r, 3.0)
-        flat = (np.repeat(cols, 6, axis=1) * (n + 1) + np.tile(cols, (1, 6))).ravel()
-        outer = (w[:, None, None] * jac[:, :, None] * jac[:, None, :]).ravel()
-        h = np.bincount(flat, outer, minlength=(n + 1) ** 2).reshape(n + 1, n + 1)[:n, :n]
-        g = np.bincount(cols.ravel(), (w[:, None] * r[:, None] * jac).ravel(), minlength=n + 1)
-        h, g = h.copy(), g[:n].copy()
-        h[prior_cols, prior_cols] += prior_w**2
-        g[prior_cols] += priors(cor, walk_gain) * prior_w
+        a, b, d, g_t, g_p = _normal_equations(t_cols, lm, jac, w, r, len(t_side), len(points))
+        a[prior_at, prior_at] += prior_w**2
+        g_t[prior_at] += priors(cor, walk_gain) * prior_w
         chain, chain_jac = walks.residuals(where, cor, walk_gain, n)
-        h += chain_jac.T @ chain_jac
-        g += chain_jac.T @ chain
+        chain_jac = chain_jac[:, t_side]
+        a += chain_jac.T @ chain_jac
+        g_t += chain_jac.T @ chain
         accepted = False
         while damping < 1e8:
-            a = h + damping * np.diag(np.diag(h) + 1e-9)
-            step = np.linalg.solve(a, -g)
-            new_cor = cor + step[:n_turn].reshape(-1, 4)
-            new_points = points + step[n_turn:-1].reshape(-1, 2)
-            new_gain = walk_gain + float(step[-1])
+            step_t, step_p = _schur_step(a, b, d, g_t, g_p, damping)
+            new_cor = cor + step_t[:n_turn].reshape(-1, 4)
+            new_points = points + step_p.reshape(-1, 2)
+            new_gain = walk_gain + float(step_t[-1])
             new_cost = total_cost(new_cor, new_points, new_gain)
             if new_cost < cost:
                 accepted = True
@@ -538,6 +544,65 @@ def _levenberg_marquardt(
         if drop < 1e-6 * max(cost, 1.0):
             break
     return cor, points, walk_gain
+
+
+def _normal_equations(
+    t_cols: np.ndarray,
+    lm: np.ndarray,
+    jac: np.ndarray,
+    w: np.ndarray,
+    r: np.ndarray,
+    n_t: int,
+    n_points: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The bearings' weighted normal equations in blocks. A residual touches one turn's
+    4 columns (of the ``n_t`` turn-side ones) and one point's 2 (``jac`` ``(K, 6)``
+    in that order): the turn block ``a`` ``(n_t, n_t)``, the turn-point block ``b``
+    ``(n_t, 2 P)``, the points' own ``(P, 2, 2)`` blocks ``d`` (points do not share a
+    residual), and the gradients of both sides."""
+    jt, jp = jac[:, :4], jac[:, 4:]
+    wt = w[:, None] * jt
+    p_cols = 2 * lm[:, None] + np.arange(2)
+    a = np.bincount(
+        (t_cols[:, :, None] * n_t + t_cols[:, None, :]).ravel(),
+        (wt[:, :, None] * jt[:, None, :]).ravel(),
+        minlength=n_t * n_t,
+    ).reshape(n_t, n_t)
+    b = np.bincount(
+        (t_cols[:, :, None] * (2 * n_points) + p_cols[:, None, :]).ravel(),
+        (wt[:, :, None] * jp[:, None, :]).ravel(),
+        minlength=n_t * 2 * n_points,
+    ).reshape(n_t, 2 * n_points)
+    d = np.bincount(
+        (4 * lm[:, None] + np.arange(4)).ravel(),  # row-major 2 x 2 blocks
+        (w[:, None, None] * jp[:, :, None] * jp[:, None, :]).ravel(),
+        minlength=4 * n_points,
+    ).reshape(n_points, 2, 2)
+    g_t = np.bincount(t_cols.ravel(), (wt * r[:, None]).ravel(), minlength=n_t)
+    g_p = np.bincount(
+        p_cols.ravel(), (w[:, None] * jp * r[:, None]).ravel(), minlength=2 * n_points
+    )
+    return a, b, d, g_t, g_p
+
+
+def _schur_step(
+    a: np.ndarray, b: np.ndarray, d: np.ndarray, g_t: np.ndarray, g_p: np.ndarray, damping: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The damped Gauss-Newton step ``(H + damping diag(H)) x = -g`` of the blocks of
+    :func:`_normal_equations`, by eliminating the points (their 2 x 2 blocks invert in
+    closed form): the turn side solves a system of its own size only."""
+    a = a + damping * np.diag(np.diag(a) + 1e-9)
+    d = d.copy()
+    d[:, 0, 0] += damping * (d[:, 0, 0] + 1e-9)
+    d[:, 1, 1] += damping * (d[:, 1, 1] + 1e-9)
+    det = d[:, 0, 0] * d[:, 1, 1] - d[:, 0, 1] * d[:, 1, 0]
+    inv = np.stack([d[:, 1, 1], -d[:, 0, 1], -d[:, 1, 0], d[:, 0, 0]], 1).reshape(-1, 2, 2)
+    inv /= det[:, None, None]
+    bp = b.reshape(len(a), -1, 2)
+    b_inv = np.einsum("ipk,pkl->ipl", bp, inv).reshape(len(a), -1)
+    x_t = np.linalg.solve(a - b_inv @ b.T, -g_t + b_inv @ g_p)
+    rhs = (g_p + b.T @ x_t).reshape(-1, 2)
+    return x_t, -np.einsum("pkl,pl->pk", inv, rhs).ravel()
 
 
 def place_turns(
@@ -610,9 +675,11 @@ def place_turns(
     # the known turns alone (home: each edge seen from two or three camera positions a
     # few decimetres apart; rough, but enough to place the other turns near their truth)
     pinned = _known_turns(known, len(turns))
-    known_views = _views([turns[k] for k in pinned], corrections[pinned], eye_forward_m)
-    landmarks = learn_landmarks(known_views, min_positions=2)
-    for k in sorted(set(range(1, len(turns))) - set(pinned.tolist())):
+    searched = sorted(set(range(1, len(turns))) - set(pinned.tolist()))
+    if searched:
+        known_views = _views([turns[k] for k in pinned], corrections[pinned], eye_forward_m)
+        landmarks = learn_landmarks(known_views, min_positions=2)
+    for k in searched:
         t = turns[k]
         scored = LearnedTurn(
             t.x, t.y, tuple(t.frames[i] for i in _spread(len(t.frames), max_frames))
