@@ -64,7 +64,7 @@ def test_it_is_a_named_tracker():
 
 
 def test_it_tracks_walks_finer_than_the_sector_maps(walks):
-    """Measured: heading 1.3° and position 6.4 cm (mean), against 3.5° and 19 cm."""
+    """Measured: heading 1.4° and position 7.7 cm (mean), against 3.5° and 19 cm."""
     bearings = walks["bearings"][:, SCORED].reshape(-1, 3).mean(axis=0)
     pose = walks["pose"][:, SCORED].reshape(-1, 3).mean(axis=0)
     assert bearings[1] < 0.12 and bearings[1] < 0.6 * pose[1], (bearings, pose)
@@ -72,7 +72,7 @@ def test_it_tracks_walks_finer_than_the_sector_maps(walks):
 
 
 def test_it_finds_the_robot_again_after_every_kidnapping(walks):
-    """Within 10 s (measured: 0.5, 4.4 and 1.0 s)."""
+    """Within 10 s (measured: 2.7, 8.0 and 2.8 s)."""
     for run in walks["bearings"]:
         after = run[130:]
         ok = (after[:, 1] < 0.2) & (after[:, 0] < 5.0)
@@ -98,6 +98,7 @@ def test_an_atlas_without_landmarks_is_warned_about_and_tracked_by_the_maps(room
         ({"bearing_outlier": 1.0}, "bearing_outlier"),
         ({"bearing_temperature": -1.0}, "bearing_temperature"),
         ({"resolution_m": -0.1}, "resolution_m"),
+        ({"min_changes_alone": 0}, "min_changes_alone"),
     ],
 )
 def test_bad_settings_are_refused(kwargs, match):

@@ -195,18 +195,34 @@ class LandmarkMap:
         if changes.size == 0:
             return total
         first = np.cumsum(c) - c
-        used, which = np.unique(landmark, return_inverse=True)
-        which = which.reshape(-1)
-        # every used landmark from every pose: (N, U)
-        d = self.positions[used][None, :, :] - eye_xy[:, None, :]
-        dist = np.maximum(np.hypot(d[..., 0], d[..., 1]), 0.05)
-        predicted = wrap_pi(np.arctan2(d[..., 1], d[..., 0]) - camera_yaw_rad[:, None])
-        var = noise_rad**2 + (self.std_m[used][None, :] / dist) ** 2
-        # every candidate from every pose: (N, C)
-        err = wrap_pi(offsets[change][None, :] - predicted[:, which])
-        var_c = var[:, which]
-        score = -0.5 * err**2 / var_c - 0.5 * np.log(var_c / noise_rad**2)
-        score = np.where(np.abs(predicted[:, which]) <= half, score, -np.inf)
+        # every candidate from every pose, in the camera's frame: (N, C) (a landmark
+        # rarely explains two changes of a frame, so nothing is shared per landmark)
+        px, py = self.positions[landmark, 0], self.positions[landmark, 1]
+        cos_yaw, sin_yaw = np.cos(camera_yaw_rad)[:, None], np.sin(camera_yaw_rad)[:, None]
+        dx = px[None, :] - eye_xy[:, 0:1]
+        dy = py[None, :] - eye_xy[:, 1:2]
+        ahead = dx * cos_yaw
+        ahead += dy * sin_yaw
+        left = dy
+        left *= cos_yaw
+        left -= dx * sin_yaw
+        predicted = np.arctan2(left, ahead)
+        # var = noise^2 + (std / distance)^2; score = -err^2 / (2 var) - log(var / noise^2) / 2
+        ratio = np.square(ahead, out=ahead)
+        ratio += np.square(left, out=left)
+        np.maximum(ratio, 0.0025, out=ratio)
+        np.divide((self.std_m[landmark] / noise_rad)[None, :] ** 2, ratio, out=ratio)
+        ratio += 1.0  # var / noise^2
+        # an offset and a prediction both in view differ by less than the field of view,
+        # so only a wide view wraps
+        err = offsets[change][None, :] - predicted
+        if half >= math.pi / 2:
+            err = wrap_pi(err)
+        score = np.square(err / noise_rad, out=err)
+        score /= ratio
+        score += np.log(ratio)
+        score *= -0.5
+        score[np.abs(predicted) > half] = -np.inf  # a landmark out of view explains nothing
         best = np.maximum.reduceat(score, first, axis=1)  # (N, matched changes)
         return total + np.logaddexp(best, log_floor).sum(axis=1)
 

@@ -15,7 +15,7 @@ from vc_gym.compass.bearings import FrameBearings
 from vc_gym.localization.bearing_sensor import BearingSensor
 from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import TrackerState
-from vc_gym.validation import open_fraction, positive_float
+from vc_gym.validation import int_at_least, open_fraction, positive_float
 
 __all__ = ["SPREAD_RANGE_M", "BearingTracker"]
 
@@ -33,10 +33,15 @@ class BearingTracker(PoseTracker):
     frame's particles are drawn from them, a kidnapping is noticed by them and the
     particles they re-draw bring a lost belief back. The colour changes' bearings
     (:class:`~vc_gym.localization.bearing_sensor.BearingSensor` on the atlas'
-    :attr:`~vc_gym.compass.CompassAtlas.landmarks`) then weigh the same particles to a
-    fraction of a degree per change: the fine pose. Their log-likelihood is divided by
-    ``bearing_temperature`` (the changes of one frame are not independent either) and
-    added to the maps' before the outlier floor. Their noise is ``bearing_noise_deg``
+    :attr:`~vc_gym.compass.CompassAtlas.landmarks`) weigh the same particles to a
+    fraction of a degree per change: the fine pose. Between the checks (every
+    ``rescore_every``-th frame, when the maps score every spot) the bearings alone weigh
+    a frame that shows at least ``min_changes_alone`` changes: the maps, re-drawn for a
+    position from a few turns, are off by decimetres and would pull the fine pose towards
+    their error. At a check, and on a frame with fewer changes (which pin the pose only
+    loosely), both weigh. The bearings' log-likelihood is divided by ``bearing_temperature`` (the
+    changes of one frame are not independent either) and added to the maps' before the
+    outlier floor. Their noise is ``bearing_noise_deg``
     widened, in quadrature, by the spread of the cloud's core (its heading, and its
     position seen from :data:`SPREAD_RANGE_M`): a broad cloud is sharpened step by step
     instead of being taken over by the particle that happens to line up a few changes.
@@ -52,6 +57,9 @@ class BearingTracker(PoseTracker):
         Density floor of a change no landmark explains, in ``(0, 1)``.
     bearing_temperature : float
         Divides the bearings' log-likelihood.
+    min_changes_alone : int
+        Fewest changes of a frame between the checks for the bearings to weigh it alone
+        (a large number: the maps weigh every frame as well).
     resolution_m, resolution_deg : float
         Added in quadrature to the particles' spread in the stated uncertainty (see
         :class:`PoseTracker`); smaller than the pose tracker's, because the bearings
@@ -68,6 +76,7 @@ class BearingTracker(PoseTracker):
         bearing_noise_deg: float = 0.5,
         bearing_outlier: float = 0.05,
         bearing_temperature: float = 1.0,
+        min_changes_alone: int = 12,
         resolution_m: float = 0.015,
         resolution_deg: float = 0.25,
         outlier: float = 0.001,
@@ -86,6 +95,7 @@ class BearingTracker(PoseTracker):
         self.bearing_noise_deg = positive_float("bearing_noise_deg", bearing_noise_deg)
         self.bearing_outlier = open_fraction("bearing_outlier", bearing_outlier)
         self.bearing_temperature = positive_float("bearing_temperature", bearing_temperature)
+        self.min_changes_alone = int_at_least("min_changes_alone", min_changes_alone, 1)
         self.sensor: BearingSensor | None = None
         self._changes: FrameBearings | None = None
 
@@ -116,6 +126,10 @@ class BearingTracker(PoseTracker):
         the bearings of its colour changes."""
         self._changes = None if self.sensor is None else self.sensor.bearings(image)
         return super().update(image, head_pan_deg, odometry)
+
+    def _fine_alone(self) -> bool:
+        changes = self._changes
+        return changes is not None and len(changes) >= self.min_changes_alone
 
     def _fine_log_likelihood(self, pan: float, poses: np.ndarray) -> np.ndarray | float:
         if self.sensor is None or self._changes is None:

@@ -266,6 +266,10 @@ class PoseTracker:
             pf.replace(outside, p[outside])
         check = self._fresh or self._frame % self.rescore_every == 0
         self._frame += 1
+        if not check and self._fine_alone():
+            # between the checks a finer measurement alone weighs the particles
+            self._weigh_by(self._fine_log_likelihood(pan, p))
+            return self._state()
         near = self._scoring_spots(p[:, :2])
         spots = None if check else np.unique(near)
         terms = self.maps.frame(image, self.camera, spots, self._gain(image))
@@ -313,10 +317,7 @@ class PoseTracker:
         scores = self._spot_scores(terms) if check else None
         if scores is not None:
             self._check_lost(scores, ll)
-        ll = ll + self._fine_log_likelihood(pan, pf.particles)
-        top = float(ll.max())
-        robust = np.log(self.outlier + (1.0 - self.outlier) * np.exp(ll - top))
-        pf.update(_Given(robust), None)
+        self._weigh_by(ll + self._fine_log_likelihood(pan, pf.particles))
         if scores is not None:
             lost = self._lost_run >= self.lost_checks
             fraction = self.reset_fraction if lost else self.inject_fraction
@@ -328,6 +329,18 @@ class PoseTracker:
                     pf.resample()
                 idx = self.rng.choice(self.n_particles, size=n, replace=False)
                 pf.replace(idx, self._drawn(scores, pan, n))
+
+    def _weigh_by(self, ll: np.ndarray) -> None:
+        """Weigh the particles by the log-likelihood ``ll`` above the outlier floor."""
+        top = float(ll.max())
+        robust = np.log(self.outlier + (1.0 - self.outlier) * np.exp(ll - top))
+        self.filter.update(_Given(robust), None)
+
+    def _fine_alone(self) -> bool:
+        """Whether, between the checks, the further measurement
+        (:meth:`_fine_log_likelihood`) alone weighs this frame's particles, the maps
+        left unscored; never here."""
+        return False
 
     def _fine_log_likelihood(self, pan: float, poses: np.ndarray) -> np.ndarray | float:
         """A further measurement's log-likelihood at the particles, added to the maps'
