@@ -52,14 +52,16 @@ MAX_VIDEOS = 1_000
 #: Most light levels one run compares (``--lights``).
 MAX_LIGHTS = 10
 #: The values ``--mode`` takes: the homing modes and a deprecated name.
-HOMING_MODE_CHOICES = ("check-home", "paper", "pose-home", "improved")
+HOMING_MODE_CHOICES = ("check-home", "paper", "pose-home", "bearings-home", "improved")
 HOMING_MODE_HELP = (
     "check-home: the spots normalised with the frames of the first turn at "
     "the true home, and home checked with a full turn before stopping; paper: the "
     "paper's procedure (normalised after walking back home by odometry, stop where "
     "the estimate says home); pose-home: check-home's learning plus turns 0.5 m around "
     "home and every spot, homing on the pose-grid tracker (the pose belief away from home, "
-    "the paper's filters near it) and checking home with a full turn; improved: "
+    "the paper's filters near it) and checking home with a full turn; bearings-home: "
+    "pose-home's learning with the colour changes kept as landmarks, homing on the "
+    "bearings tracker, checking home with a full turn and stopping within 5 cm; improved: "
     "deprecated name of check-home"
 )
 
