@@ -38,6 +38,25 @@ def test_each_colour_edge_is_a_bearing_to_a_fraction_of_a_degree(striped, learne
         assert np.max(errors) < 0.3 and np.median(errors) < 0.15, errors
 
 
+def test_a_dimmer_frame_read_at_its_gain_shows_the_same_changes(striped, learned):
+    """Half the light and a gain of 2 give back the classes and the columns: without
+    the gain the dim frame's classes, and so its changes, are others."""
+    from vc_gym.exposure import gain_table
+
+    room, _ = striped
+    colors, _ = learned
+    img, cam = view(room, 0.3, -0.4, 20.0)
+    bright = bands_bearings(img, cam, colors)
+    dim = np.take(gain_table(0.5), img)
+    again = bands_bearings(dim, cam, colors, gain=2.0)
+    assert np.array_equal(again.pairs, bright.pairs)
+    assert np.max(np.abs(again.offsets_deg - bright.offsets_deg)) < 0.1
+    as_is = bands_bearings(dim, cam, colors)
+    assert len(as_is) != len(bright) or not np.array_equal(as_is.pairs, bright.pairs)
+    with pytest.raises(ValueError, match="gain"):
+        bands_bearings(img, cam, colors, gain=0.0)
+
+
 def test_the_learned_turns_place_every_edge_they_all_see(striped, learned):
     _, points = striped
     _, views = learned

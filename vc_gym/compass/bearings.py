@@ -29,8 +29,9 @@ import numpy as np
 
 from vc_gym.compass.camera import Camera
 from vc_gym.compass.colors import ColorClasses
+from vc_gym.exposure import gain_table
 from vc_gym.images import check_image
-from vc_gym.validation import int_at_least
+from vc_gym.validation import int_at_least, positive_float
 
 __all__ = [
     "DEFAULT_BANDS_DEG",
@@ -128,9 +129,10 @@ def bands_bearings(
     bands_deg: tuple[tuple[float, float], ...] = DEFAULT_BANDS_DEG,
     min_run_px: int = 3,
     max_gap_px: int = 3,
+    gain: float = 1.0,
 ) -> FrameBearings:
     """The changes of :func:`frame_bearings` in every band of ``bands_deg``, each kept
-    with its band (:attr:`FrameBearings.band`).
+    with its band (:attr:`FrameBearings.band`), the frame's linear light times ``gain``.
 
     Raises
     ------
@@ -139,7 +141,7 @@ def bands_bearings(
     """
     bands = check_bands(bands_deg)
     found = [
-        frame_bearings(image, camera, colors, band, min_run_px, max_gap_px) for band in bands
+        frame_bearings(image, camera, colors, band, min_run_px, max_gap_px, gain) for band in bands
     ]
     return FrameBearings(
         np.concatenate([f.offsets_deg for f in found]),
@@ -170,6 +172,7 @@ def frame_bearings(
     band_deg: tuple[float, float] = DEFAULT_BAND_DEG,
     min_run_px: int = 3,
     max_gap_px: int = 3,
+    gain: float = 1.0,
 ) -> FrameBearings:
     """The colour-class changes of ``image`` along its horizon band, as bearings.
 
@@ -190,6 +193,10 @@ def frame_bearings(
     max_gap_px : int
         Widest stretch of other classes between two surfaces whose change is still
         one event (a blurred or anti-aliased edge); wider, no event.
+    gain : float
+        Multiplies the frame's linear light before the pixels are classified (e.g. the
+        session's light, :class:`~vc_gym.exposure.SessionLight`, so that a dimmer room
+        shows the classes it was learned in).
 
     Returns
     -------
@@ -199,6 +206,7 @@ def frame_bearings(
     img = check_image(image, "image")
     int_at_least("min_run_px", min_run_px, 1)
     int_at_least("max_gap_px", max_gap_px, 0)
+    gain = positive_float("gain", gain)
     height, width = img.shape[:2]
     n = colors.n_colors
     band = (check_band(band_deg),)
@@ -206,7 +214,8 @@ def frame_bearings(
     empty = np.zeros(0, np.int64)
     if rows.stop - rows.start < 1:
         return FrameBearings(np.zeros(0), empty, empty, n, camera.hfov_deg, bands=band)
-    classes = colors.classify(img[rows]).astype(np.int64)  # (R, W)
+    pixels = img[rows] if gain == 1.0 else np.take(gain_table(gain), img[rows])
+    classes = colors.classify(pixels).astype(np.int64)  # (R, W)
     # how many band rows show each class, per column
     counts = np.bincount((classes * width + np.arange(width)).ravel(), minlength=n * width)
     share = counts.reshape(n, width) / classes.shape[0]

@@ -77,10 +77,10 @@ class BearingSensor:
             eye_forward_m = landmarks.eye_forward_m
         self.eye_forward_m = finite_float("eye_forward_m", eye_forward_m)
 
-    def bearings(self, image: np.ndarray) -> FrameBearings:
+    def bearings(self, image: np.ndarray, gain: float = 1.0) -> FrameBearings:
         """The changes of one frame in the landmarks' bands (what
-        :meth:`pose_log_likelihood` reads)."""
-        return bands_bearings(image, self.camera, self.colors, self.landmarks.bands)
+        :meth:`pose_log_likelihood` reads), its linear light times ``gain``."""
+        return bands_bearings(image, self.camera, self.colors, self.landmarks.bands, gain=gain)
 
     def pose_log_likelihood(
         self,

@@ -12,6 +12,8 @@ import numpy as np
 from vc_gym.angles import circular_mean, wrap180
 from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.compass.bearings import FrameBearings
+from vc_gym.compass.light_gain import REFERENCE_EXPOSURES
+from vc_gym.exposure import SessionLight
 from vc_gym.localization.bearing_sensor import BearingSensor
 from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import TrackerState
@@ -45,6 +47,10 @@ class BearingTracker(PoseTracker):
     widened, in quadrature, by the spread of the cloud's core (its heading, and its
     position seen from :data:`SPREAD_RANGE_M`): a broad cloud is sharpened step by step
     instead of being taken over by the particle that happens to line up a few changes.
+
+    The frames' changes are read at the session's light: the median gain of the recent
+    frames (:class:`~vc_gym.exposure.SessionLight` over the maps' per-frame gains), so a
+    dimmer room shows the colour classes it was learned in, whatever a frame shows.
 
     An atlas without landmarks (learned without ``landmarks=True``) leaves the maps
     alone, with a warning: the tracker is then the pose tracker with its stated spread.
@@ -97,12 +103,14 @@ class BearingTracker(PoseTracker):
         self.bearing_temperature = positive_float("bearing_temperature", bearing_temperature)
         self.min_changes_alone = int_at_least("min_changes_alone", min_changes_alone, 1)
         self.sensor: BearingSensor | None = None
+        self.bearing_light = SessionLight(self.light.window)  # the maps' light window
         self._changes: FrameBearings | None = None
 
     def reset(self, atlas: CompassAtlas, camera: Camera, dt_s: float) -> None:
         """Forget the pose; (re)build the pose maps and the bearing sensor for ``atlas``."""
         super().reset(atlas, camera, dt_s)
         self.sensor = None
+        self.bearing_light.reset()
         if atlas.landmarks is None or len(atlas.landmarks) == 0:
             warnings.warn(
                 "the atlas has no landmarks (learn it with landmarks=True): the bearings "
@@ -124,8 +132,20 @@ class BearingTracker(PoseTracker):
     ) -> TrackerState:
         """Motion update by ``odometry``, then sensor update by ``image``: the maps and
         the bearings of its colour changes."""
-        self._changes = None if self.sensor is None else self.sensor.bearings(image)
+        self._changes = (
+            None if self.sensor is None else self.sensor.bearings(image, self._light_gain(image))
+        )
         return super().update(image, head_pan_deg, odometry)
+
+    def _light_gain(self, image: np.ndarray) -> float:
+        """The session's gain (1 for maps without a reference level, or a black frame)."""
+        compass = self.maps.maps[0]
+        if compass.config.exposure not in REFERENCE_EXPOSURES:
+            return 1.0
+        # in whole stops: the frames of a route read a fraction of a stop off the
+        # learning frames' level at the same light, which the classes tolerate
+        light = self.bearing_light.update(compass.frame_gain(image, self.camera))
+        return 2.0 ** round(math.log2(light))
 
     def _fine_alone(self) -> bool:
         changes = self._changes
