@@ -41,16 +41,18 @@ class BearingTracker(PoseTracker):
     a frame that shows at least ``min_changes_alone`` changes: the maps, re-drawn for a
     position from a few turns, are off by decimetres and would pull the fine pose towards
     their error. At a check, and on a frame with fewer changes (which pin the pose only
-    loosely), both weigh. The bearings' log-likelihood is divided by ``bearing_temperature`` (the
-    changes of one frame are not independent either) and added to the maps' before the
-    outlier floor. Their noise is ``bearing_noise_deg``
+    loosely), both weigh. The bearings' log-likelihood is divided by
+    ``bearing_temperature`` (the changes of one frame are not independent either) and
+    added to the maps' before the outlier floor. Their noise is ``bearing_noise_deg``
     widened, in quadrature, by the spread of the cloud's core (its heading, and its
     position seen from :data:`SPREAD_RANGE_M`): a broad cloud is sharpened step by step
     instead of being taken over by the particle that happens to line up a few changes.
 
-    The frames' changes are read at the session's light: the median gain of the recent
-    frames (:class:`~vc_gym.exposure.SessionLight` over the maps' per-frame gains), so a
-    dimmer room shows the colour classes it was learned in, whatever a frame shows.
+    The frames' changes are read at the session's light in whole stops: the median gain
+    of the recent frames (:class:`~vc_gym.exposure.SessionLight` over the maps'
+    per-frame gains), rounded to a power of 2, so that a room at half the light shows
+    the colour classes it was learned in, while the fraction of a stop by which a
+    route's frames read off the learning frames at the same light changes nothing.
 
     An atlas without landmarks (learned without ``landmarks=True``) leaves the maps
     alone, with a warning: the tracker is then the pose tracker with its stated spread.
