@@ -180,9 +180,7 @@ class LandmarkMap:
         if not matched.any():
             return total
         c = count[matched]
-        first = np.cumsum(c) - c  # where each change's candidates start
-        within = np.arange(int(c.sum())) - np.repeat(first, c)
-        landmark = order[np.repeat(lo[matched], c) + within]
+        landmark = order[_gather(lo[matched], lo[matched] + c)]
         change = np.repeat(np.flatnonzero(matched), c)
         offsets = np.radians(bearings.offsets_deg)
         # drop the candidates that miss by so much from every pose that their term is

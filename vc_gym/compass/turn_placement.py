@@ -212,7 +212,8 @@ class _Walks:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Residuals ``(3W,)`` (in σ) of where each walk, its length times ``gain``,
         ends against its turn's first frame, and their dense Jacobian ``(3W, n)`` over
-        :func:`_levenberg_marquardt`'s parameters (headings in radians; the gain last)."""
+        the turns' parameters of :func:`_levenberg_marquardt` (4 each, headings in
+        radians) and the gain, column ``n - 1`` (the walks touch no landmark)."""
         w_n = len(self.turn)
         r = np.zeros(3 * w_n)
         jac = np.zeros((3 * w_n, n))
@@ -463,10 +464,12 @@ def _levenberg_marquardt(
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The steps of :func:`adjust_turns` for one matching. The parameters are the turns'
     corrections (4 each, heading in radians; the ``pinned`` turns' positions and first
-    headings held by a stiff prior, :data:`_PIN`: the map's frame), the points (2 each) and the gain
-    of the odometry's walk lengths."""
+    headings held by a stiff prior, :data:`_PIN`: the map's frame), the gain of the
+    odometry's walk lengths (column ``4 T``: with the turns', the turn side of the
+    normal equations) and the points (2 each, eliminated: :func:`_schur_step`)."""
     n_turns = len(cor)
-    n_turn, n = 4 * n_turns, 4 * n_turns + 2 * len(points) + 1
+    n_turn = 4 * n_turns
+    n_t = n_turn + 1  # the turn side: the turns' columns, then the gain's
     t_cols = 4 * c.turn[:, None] + np.arange(4)  # the turn columns each residual touches
     scale_cols = 4 * np.arange(n_turns) + 3
 
@@ -493,7 +496,7 @@ def _levenberg_marquardt(
         )
 
     def total_cost(cr: np.ndarray, pts: np.ndarray, gain: float) -> float:
-        chain = walks.residuals(where, cr, gain, n)[0]
+        chain = walks.residuals(where, cr, gain, n_t)[0]
         prior = priors(cr, gain)
         return (
             _huber(residuals(cr, pts)[0], 3.0)[0]
@@ -502,7 +505,7 @@ def _levenberg_marquardt(
         )
 
     pin_cols = (4 * pinned[:, None] + np.arange(3)).ravel()
-    prior_cols = np.concatenate([scale_cols, pin_cols, [n - 1]])
+    prior_cols = np.concatenate([scale_cols, pin_cols, [n_turn]])
     prior_w = np.concatenate(
         [
             np.full(n_turns, 1.0 / scale_sigma),
@@ -510,19 +513,15 @@ def _levenberg_marquardt(
             [1.0 / WALK_GAIN_SIGMA],
         ]
     )
-    # the turns' columns and the gain's (the rest are the points', 2 each)
-    t_side = np.r_[np.arange(n_turn), n - 1]
-    prior_at = np.searchsorted(t_side, prior_cols)
     damping = 1e-3
     cost = total_cost(cor, points, walk_gain)
     for _ in range(max_steps):
         r, jac = residuals(cor, points)
         _, w = _huber(r, 3.0)
-        a, b, d, g_t, g_p = _normal_equations(t_cols, lm, jac, w, r, len(t_side), len(points))
-        a[prior_at, prior_at] += prior_w**2
-        g_t[prior_at] += priors(cor, walk_gain) * prior_w
-        chain, chain_jac = walks.residuals(where, cor, walk_gain, n)
-        chain_jac = chain_jac[:, t_side]
+        a, b, d, g_t, g_p = _normal_equations(t_cols, lm, jac, w, r, n_t, len(points))
+        a[prior_cols, prior_cols] += prior_w**2
+        g_t[prior_cols] += priors(cor, walk_gain) * prior_w
+        chain, chain_jac = walks.residuals(where, cor, walk_gain, n_t)
         a += chain_jac.T @ chain_jac
         g_t += chain_jac.T @ chain
         accepted = False
