@@ -99,6 +99,9 @@ def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
     assert loaded.n_colors == room_atlas.compasses[0].config.n_colors
     assert loaded.eye_forward_m == 0.25  # where the camera sat: the sensor's too
     assert loaded.bands == ((0.5, 4.0),)  # the bands its changes were read in
+    assert loaded.light_gain == 1.0  # learned at the colour classes' light
+    darker = CompassAtlas.load(_with_landmarks(room_atlas, tmp_path, light_gain=2.0))
+    assert darker.landmarks.light_gain == 2.0  # a frame is read relative to it
 
 
 @pytest.mark.parametrize(
@@ -117,6 +120,9 @@ def test_the_landmarks_are_saved_with_the_atlas(room_atlas, saved, tmp_path):
         ({"bands": ((0.5, float("nan")),)}, "band"),
         ({"bands": ()}, "bands must number"),
         ({"bands": ((0.5, 4.0),) * 17}, "bands must number"),
+        ({"light_gain": 0.0}, "light_gain"),
+        ({"light_gain": float("inf")}, "light_gain"),
+        ({"light_gain": 2.0**9}, "light_gain"),
     ],
 )
 def test_bad_landmarks_in_a_file_are_refused(room_atlas, tmp_path, changes, message):

@@ -4,6 +4,7 @@ in the striped ray-cast room whose colour edges are known exactly."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -72,6 +73,18 @@ def test_turns_whose_believed_poses_drifted_are_placed_anew(drifted):
     # where the turns were believed to be, the same frames place the edges far worse
     believed = learn_landmarks([v for t in turns for v in t.views(AHEAD)])
     assert np.median(_gaps(believed.positions, points)) > 5 * np.median(gaps)
+
+
+def test_the_landmarks_keep_the_light_their_frames_were_seen_at(drifted):
+    """The session light of the turns' frame gains (median, in thirds of a stop), 1 when
+    no turn read its frames' gains."""
+    _, turns, _ = drifted
+    assert place_turns(turns[:2], eye_forward_m=AHEAD)[0].light_gain == 1.0
+    lit = [
+        replace(t, frame_gains=(1.9, 2.1, 2.0, float("inf"))[: 3 + k])
+        for k, t in enumerate(turns[:2])
+    ]
+    assert place_turns(lit, eye_forward_m=AHEAD)[0].light_gain == 2.0
 
 
 def test_the_adjustment_alone_beats_the_grid_search(drifted):

@@ -274,9 +274,9 @@ def test_learning_with_turns_around_and_landmarks_keeps_what_the_trackers_use(tm
     """The turns around home and every spot are atlas entries of their own (the pose
     tracker's input). With ``landmarks``, the turns placed anew by their colour changes
     stand nearer where they were learned than where the robot believed, and the atlas
-    keeps the landmarks, through the place cache too. Measured: 307 landmarks in four
+    keeps the landmarks, through the place cache too. Measured: 317 landmarks in four
     bands; the turns' starts 24 cm from the belief (median), 2.1 cm once placed (at most
-    5.5 cm)."""
+    5.3 cm)."""
     from vc_gym.compass.pose_maps import around_groups
     from vc_gym.envs import CompassObservation
 
@@ -294,6 +294,8 @@ def test_learning_with_turns_around_and_landmarks_keeps_what_the_trackers_use(tm
     np.testing.assert_array_equal(corrections[0, :3], 0.0)  # home: the map's frame
     landmarks = result.atlas.landmarks
     assert landmarks is not None and len(landmarks) >= 30 and np.all(landmarks.support >= 3)
+    # maps without a reference level (exposure "none") read no light: the frames' own
+    assert landmarks.light_gain == 1.0 and all(t.frame_gains == () for t in result.turns)
     # the true path holds every frame of the turns after home's, in order
     path = np.array(result.true_path)
     assert len(result.turns) == 25 and sum(len(t.frames) for t in result.turns[1:]) == len(path)
@@ -316,5 +318,6 @@ def test_learning_with_turns_around_and_landmarks_keeps_what_the_trackers_use(tm
     assert again.unwrapped.cached_learner.learned is False
     assert again.unwrapped.atlas.names == atlas.names
     np.testing.assert_allclose(again.unwrapped.atlas.landmarks.positions, landmarks.positions)
+    assert again.unwrapped.atlas.landmarks.light_gain == landmarks.light_gain
     assert obs["goodness"].shape == (25,) and np.all(np.isfinite(obs["position"]))
     again.close()

@@ -57,6 +57,41 @@ def test_a_dimmer_frame_read_at_its_gain_shows_the_same_changes(striped, learned
         bands_bearings(img, cam, colors, gain=0.0)
 
 
+def test_a_frame_read_as_a_dimmer_room_shows_it_holds_the_edges_it_would_see(striped, learned):
+    """A surface whose colour lies on a class border changes class in a room at half the
+    light read at a gain of 2 (its levels rounded): its edges show another pair there.
+    With ``dimmed_stops=(1,)`` the full-light frame's changes include that reading's, so
+    every change of the dimmer frame is among them, at its bearing."""
+    from vc_gym.exposure import gain_table
+
+    room, _ = striped
+    colors, _ = learned
+    # on the blend from red to violet: a colour the round trip through half the light
+    # moves into another class
+    blend = np.linspace(0.0, 1.0, 512)[:, None]
+    shades = (PALETTE[0] * (1 - blend) + PALETTE[4] * blend).round().astype(np.uint8)
+    back = np.take(gain_table(2.0), np.take(gain_table(0.5), shades))
+    flips = np.flatnonzero(colors.classify(shades[None])[0] != colors.classify(back[None])[0])
+    assert flips.size, "no colour of the blend changes class through half the light"
+    img, cam = view(room, 0.3, -0.4, 20.0)
+    img[:, 60:150] = shades[flips[0]]
+    dim = np.take(gain_table(0.5), img)
+    seen_dim = bands_bearings(dim, cam, colors, gain=2.0)
+    plain = bands_bearings(img, cam, colors)
+    both = bands_bearings(img, cam, colors, dimmed_stops=(1.0,))
+
+    def found(changes, among):
+        same = changes.pairs[:, None] == among.pairs[None, :]
+        near = np.abs(changes.offsets_deg[:, None] - among.offsets_deg[None, :]) < 0.1
+        return np.any(same & near, axis=1)
+
+    assert not np.all(found(seen_dim, plain))  # the repainted surface's edges: other pairs
+    assert np.all(found(seen_dim, both))
+    assert np.all(found(plain, both))  # the full light's own changes are all kept
+    with pytest.raises(ValueError, match="dimmed_stops"):
+        bands_bearings(img, cam, colors, dimmed_stops=(0.0,))
+
+
 def test_the_learned_turns_place_every_edge_they_all_see(striped, learned):
     _, points = striped
     _, views = learned

@@ -37,6 +37,7 @@ __all__ = [
     "DEFAULT_BANDS_DEG",
     "DEFAULT_BAND_DEG",
     "MAX_BANDS",
+    "SAME_CHANGE_DEG",
     "FrameBearings",
     "bands_bearings",
     "check_band",
@@ -53,6 +54,9 @@ DEFAULT_BAND_DEG = (0.5, 4.0)
 DEFAULT_BANDS_DEG = ((0.5, 4.0), (4.0, 10.0), (10.0, 20.0), (20.0, 30.0))
 #: Most bands a frame is read in (a landmark map file names its bands).
 MAX_BANDS = 16
+#: How far apart two readings' changes of one pair may lie and be the same change
+#: (degrees: two pixels of the head camera).
+SAME_CHANGE_DEG = 0.55
 
 
 @dataclass(frozen=True)
@@ -130,16 +134,49 @@ def bands_bearings(
     min_run_px: int = 3,
     max_gap_px: int = 3,
     gain: float = 1.0,
+    dimmed_stops: tuple[float, ...] = (),
 ) -> FrameBearings:
     """The changes of :func:`frame_bearings` in every band of ``bands_deg``, each kept
     with its band (:attr:`FrameBearings.band`), the frame's linear light times ``gain``.
 
+    For each ``s`` of ``dimmed_stops`` the frame is also read as a room ``s`` stops
+    darker would show it, read back at the gain ``2**s`` (its 8-bit levels rounded as
+    the darker frame's are), and a change only that reading shows (no change of the same
+    band and pair within :data:`SAME_CHANGE_DEG` in the readings before) is added. The
+    class of a surface whose colour lies on the border of two classes flips with a level
+    of rounding: its edges then show another pair at the same bearing. Landmarks learned
+    from such readings hold the edge under both pairs, so that a frame of the dimmer
+    room read at its gain finds it.
+
     Raises
     ------
     ValueError
-        On a bad image or band, or more than :data:`MAX_BANDS` bands.
+        On a bad image or band, more than :data:`MAX_BANDS` bands, or a dimming that is
+        not a finite number of stops > 0.
     """
     bands = check_bands(bands_deg)
+    dimmed = [positive_float("dimmed_stops", v) for v in dimmed_stops]
+    found = _read_bands(image, camera, colors, bands, min_run_px, max_gap_px, gain)
+    for stops in dimmed:
+        img = check_image(image, "image")
+        darker = np.take(gain_table(2.0**-stops), img)
+        other = _read_bands(
+            darker, camera, colors, bands, min_run_px, max_gap_px, gain * 2.0**stops
+        )
+        found = _joined(found, other)
+    return found
+
+
+def _read_bands(
+    image: np.ndarray,
+    camera: Camera,
+    colors: ColorClasses,
+    bands: tuple[tuple[float, float], ...],
+    min_run_px: int,
+    max_gap_px: int,
+    gain: float,
+) -> FrameBearings:
+    """:func:`frame_bearings` in every band (checked), the changes kept with their band."""
     found = [
         frame_bearings(image, camera, colors, band, min_run_px, max_gap_px, gain) for band in bands
     ]
@@ -151,6 +188,23 @@ def bands_bearings(
         float(camera.hfov_deg),
         np.concatenate([np.full(len(f), b, np.int64) for b, f in enumerate(found)]),
         bands,
+    )
+
+
+def _joined(changes: FrameBearings, other: FrameBearings) -> FrameBearings:
+    """``changes`` and the changes of ``other`` it lacks (no change of the same band and
+    class pair within :data:`SAME_CHANGE_DEG`)."""
+    same = other.pairs[:, None] == changes.pairs[None, :]
+    near = np.abs(other.offsets_deg[:, None] - changes.offsets_deg[None, :]) <= SAME_CHANGE_DEG
+    new = ~np.any(same & near, axis=1)
+    return FrameBearings(
+        np.concatenate([changes.offsets_deg, other.offsets_deg[new]]),
+        np.concatenate([changes.left, other.left[new]]),
+        np.concatenate([changes.right, other.right[new]]),
+        changes.n_colors,
+        changes.hfov_deg,
+        np.concatenate([changes.band, other.band[new]]),
+        changes.bands,
     )
 
 

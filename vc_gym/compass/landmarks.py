@@ -20,6 +20,7 @@ import numpy as np
 
 from vc_gym.angles import wrap_pi
 from vc_gym.compass.bearings import DEFAULT_BAND_DEG, MAX_BANDS, FrameBearings, check_bands
+from vc_gym.exposure import MAX_GAIN_STOPS
 from vc_gym.validation import (
     MAX_ABS_METRES,
     finite_float,
@@ -39,6 +40,10 @@ __all__ = [
 
 #: Most landmarks a map file may hold (a room's colour edges number in the hundreds).
 MAX_LANDMARKS = 100_000
+#: A cloud of poses is scored in two groups, its core (within this distance of its median
+#: position, m, and :data:`CORE_DEG` of its mean direction) and the rest.
+CORE_M = 0.3
+CORE_DEG = 10.0
 #: The entries of a landmark map in a map file (see :meth:`LandmarkMap.to_arrays`).
 _KEYS = ("positions", "pairs", "std_m", "support")
 
@@ -109,6 +114,11 @@ class LandmarkMap:
         sensor predicts bearings from there for a body pose).
     bands : tuple of (float, float)
         The bands the changes were read in (:func:`~vc_gym.compass.bearings.bands_bearings`).
+    light_gain : float
+        The light of the learning frames, as the gain that brings them to the colour
+        classes' reference level (:class:`~vc_gym.exposure.SessionLight` of their
+        per-frame gains; 1 when unknown). Their changes were read without a gain, so a
+        later frame is read at its session's gain divided by this one.
     """
 
     positions: np.ndarray
@@ -118,6 +128,7 @@ class LandmarkMap:
     n_colors: int
     eye_forward_m: float = 0.0
     bands: tuple[tuple[float, float], ...] = (DEFAULT_BAND_DEG,)
+    light_gain: float = 1.0
 
     def __len__(self) -> int:
         return int(self.pairs.size)
@@ -183,13 +194,37 @@ class LandmarkMap:
         landmark = order[_gather(lo[matched], lo[matched] + c)]
         change = np.repeat(np.flatnonzero(matched), c)
         offsets = np.radians(bearings.offsets_deg)
+        # a tracker's cloud is tight but for a few particles drawn afresh far away, which
+        # would widen the reach of every pose: those are scored apart
+        out = np.empty(len(eye_xy))
+        for poses in _pose_groups(eye_xy, camera_yaw_rad):
+            out[poses] = self._candidates_score(
+                landmark, change, offsets, eye_xy[poses], camera_yaw_rad[poses],
+                noise_rad, half, log_floor, int(np.count_nonzero(matched)),
+            )  # fmt: skip
+        return total + out
+
+    def _candidates_score(
+        self,
+        landmark: np.ndarray,
+        change: np.ndarray,
+        offsets: np.ndarray,
+        eye_xy: np.ndarray,
+        camera_yaw_rad: np.ndarray,
+        noise_rad: float,
+        half: float,
+        log_floor: float,
+        n_matched: int,
+    ) -> np.ndarray:
+        """The matched changes' terms at the poses, from the candidates ``(landmark,
+        change)`` (grouped by change) of :meth:`log_likelihood`."""
         # drop the candidates that miss by so much from every pose that their term is
         # below the floor by more than e^20 (the answer changes by less than 1e-8)
         keep = self._within_reach(landmark, offsets[change], eye_xy, camera_yaw_rad,
                                   noise_rad, half, log_floor)  # fmt: skip
         landmark, change = landmark[keep], change[keep]
         changes, c = np.unique(change, return_counts=True)
-        total += log_floor * int(np.count_nonzero(matched) - changes.size)
+        total = np.full(len(eye_xy), log_floor * (n_matched - changes.size))
         if changes.size == 0:
             return total
         first = np.cumsum(c) - c
@@ -260,6 +295,7 @@ class LandmarkMap:
             f"{prefix}support": self.support.astype(np.int64),
             f"{prefix}eye_forward_m": np.array(self.eye_forward_m, np.float64),
             f"{prefix}bands": np.array(self.bands, np.float64).reshape(-1, 2),
+            f"{prefix}light_gain": np.array(self.light_gain, np.float64),
         }
 
     @classmethod
@@ -276,7 +312,9 @@ class LandmarkMap:
             ``n_colors`` classes, a negative or non-finite uncertainty, a support
             below 2, a camera offset that is not one number within ±1 m (a map
             without one has the camera at the body's centre), or bands that are not 1 to
-            ``MAX_BANDS`` pairs of elevations (a map without them: the one default band).
+            ``MAX_BANDS`` pairs of elevations (a map without them: the one default band),
+            or a learning light that is not one number within ±``MAX_GAIN_STOPS`` stops
+            (a map without one: 1).
         """
         missing = [k for k in _KEYS if prefix + k not in arrays]
         if missing:
@@ -311,10 +349,33 @@ class LandmarkMap:
         eye = np.asarray(arrays.get(prefix + "eye_forward_m", 0.0))
         if eye.shape != () or eye.dtype.kind != "f" or not abs(float(eye)) <= 1.0:
             raise ValueError("landmark eye_forward_m must be one float within ±1 m")
+        light = np.asarray(arrays.get(prefix + "light_gain", 1.0))
+        if light.shape != () or light.dtype.kind != "f" or not _is_gain(float(light)):
+            raise ValueError(
+                f"landmark light_gain must be one float within ±{MAX_GAIN_STOPS} stops of 1"
+            )
         return cls(
             pos.astype(np.float64), pairs.astype(np.int64), std.astype(np.float64),
-            support.astype(np.int64), int(n_colors), float(eye), bands,
+            support.astype(np.int64), int(n_colors), float(eye), bands, float(light),
         )  # fmt: skip
+
+
+def _pose_groups(eye_xy: np.ndarray, camera_yaw_rad: np.ndarray) -> list[np.ndarray]:
+    """The poses within :data:`CORE_M` and :data:`CORE_DEG` of their median position and
+    mean direction, and the rest (one group when either is empty)."""
+    centre = np.median(eye_xy, axis=0)
+    yaw = math.atan2(float(np.sin(camera_yaw_rad).sum()), float(np.cos(camera_yaw_rad).sum()))
+    core = (np.hypot(*(eye_xy - centre).T) <= CORE_M) & (
+        np.abs(wrap_pi(camera_yaw_rad - yaw)) <= math.radians(CORE_DEG)
+    )
+    if core.all() or not core.any():
+        return [np.arange(len(eye_xy))]
+    return [np.flatnonzero(core), np.flatnonzero(~core)]
+
+
+def _is_gain(gain: float) -> bool:
+    """A finite gain > 0 within ±MAX_GAIN_STOPS stops of 1."""
+    return math.isfinite(gain) and gain > 0 and abs(math.log2(gain)) <= MAX_GAIN_STOPS
 
 
 def _rays(views: Iterable[LearnedView]) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, tuple]:

@@ -20,6 +20,7 @@ import numpy as np
 from vc_gym.angles import wrap_pi
 from vc_gym.compass.bearings import FrameBearings
 from vc_gym.compass.landmarks import LandmarkMap, LearnedView, eye_positions, learn_landmarks
+from vc_gym.exposure import SessionLight
 from vc_gym.poses import body_to_world
 from vc_gym.validation import finite_float, int_at_least, positive_float
 
@@ -69,12 +70,17 @@ class LearnedTurn:
         ``(forward m, left m, turn deg)``: how far the odometry says the body moved from
         the previous turn's last frame to this turn's first, in the body's frame at that
         last frame. It ties the turns in a chain (``None``: placed on its own).
+    frame_gains : tuple of float
+        The frames' gains to the colour classes' reference level
+        (:meth:`~vc_gym.compass.VisualCompass.frame_gain`; empty when not read): the
+        light the changes were seen at.
     """
 
     x: float
     y: float
     frames: tuple[tuple[FrameBearings, float, float], ...]
     walk: tuple[float, float, float] | None = None
+    frame_gains: tuple[float, ...] = ()
 
     def body_yaws(self, correction: Correction = NO_CORRECTION) -> np.ndarray:
         """``(len(frames),)`` body headings (deg) under ``correction``
@@ -658,7 +664,9 @@ def place_turns(
     Returns
     -------
     landmarks : LandmarkMap
-        From every turn at its corrected pose.
+        From every turn at its corrected pose, with the light of the turns' frames
+        (:class:`~vc_gym.exposure.SessionLight` of their ``frame_gains``; 1 if none
+        were read).
     corrections : numpy.ndarray
         ``(len(turns), 4)``: the :data:`Correction` ``(dx m, dy m, dyaw deg, turn scale)``
         of each turn (home's position and first heading unchanged: the map's frame).
@@ -715,7 +723,8 @@ def place_turns(
             turns, first, corrections, eye_forward_m, noise_deg=noise_deg, known=known
         )
     landmarks = learn_landmarks(_views(turns, corrections, eye_forward_m))
-    return replace(landmarks, eye_forward_m=eye_forward_m), corrections
+    light = SessionLight.of(g for t in turns for g in t.frame_gains)
+    return replace(landmarks, eye_forward_m=eye_forward_m, light_gain=light), corrections
 
 
 def _views(turns: list[LearnedTurn], corrections: np.ndarray, eye_forward_m: float) -> list:

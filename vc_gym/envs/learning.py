@@ -26,7 +26,8 @@ from tqdm import tqdm
 
 from vc_gym.angles import interp_circular, wrap180, wrap360
 from vc_gym.compass import Camera, ColorClasses, CompassAtlas, CompassConfig, VisualCompass
-from vc_gym.compass.bearings import bands_bearings
+from vc_gym.compass.bearings import FrameBearings, bands_bearings
+from vc_gym.compass.light_gain import REFERENCE_EXPOSURES
 from vc_gym.compass.turn_placement import LearnedTurn, place_turns
 from vc_gym.filters import HeadingGridFilter
 from vc_gym.poses import body_to_world, compose, world_to_body
@@ -44,6 +45,7 @@ from vc_gym.validation import (
 
 __all__ = [
     "HEAD_SCAN_DEG",
+    "LANDMARK_DIMMED_STOPS",
     "HOME",
     "NORMALISE_AT",
     "SPOT_NAMES",
@@ -67,6 +69,11 @@ SPOT_NAMES = ("east", "north", "west", "south")
 NORMALISE_AT = ("return", "start")
 #: Head pans cycled while the robot learns a direction, and while it stands still homing.
 HEAD_SCAN_DEG = (-40.0, -20.0, 0.0, 20.0, 40.0, 20.0, 0.0, -20.0)
+#: With landmarks and maps that read the light: the learning frames are also read as a
+#: room this many stops darker would show them
+#: (:func:`~vc_gym.compass.bearings.bands_bearings`), so that an edge of a surface whose
+#: class flips with a level of rounding is learned under both pairs.
+LANDMARK_DIMMED_STOPS = (1.0,)
 
 
 #: The turns learned around home and each spot with ``around_m``, in the order walked:
@@ -470,6 +477,7 @@ class ScriptedLearner:
         each with head scanning (4.3)."""
         vc = VisualCompass(self.config.compass, colors)
         frames = []  # with landmarks: (changes, body heading by odometry, head pan)
+        gains = []  # with landmarks: the frames' light
         start = None  # the belief and the odometry's count at the turn's first frame
         for k in range(8):
             self._turn_to(45.0 * k)
@@ -484,13 +492,14 @@ class ScriptedLearner:
                     # the heading belief follows the home map, whose parallax bends it
                     # away from home; the odometry counts the turn itself well
                     yaw = start[2] + self.turn_accum - start[3]
-                    changes = bands_bearings(self.obs["image"], self.camera, colors)
+                    changes = _landmark_changes(vc, self.obs["image"], self.camera)
                     frames.append((changes, float(yaw), pan))
+                    gains.extend(_frame_gains(vc, [self.obs["image"]], self.camera))
                     self._last_frame_odometry = self.odometry.copy()
                 bar.update()
         if frames:
             self.turns.append(
-                LearnedTurn(float(start[0]), float(start[1]), tuple(frames), start[4])
+                LearnedTurn(float(start[0]), float(start[1]), tuple(frames), start[4], tuple(gains))
             )
         return vc
 
@@ -575,12 +584,13 @@ class ScriptedLearner:
                     y0,
                     tuple(
                         (
-                            bands_bearings(image, self.camera, colors),
+                            _landmark_changes(home, image, self.camera),
                             start + turn * self.rot_scale,
                             pan,
                         )
                         for image, turn, pan, _ in frames
                     ),
+                    frame_gains=_frame_gains(home, self._home_frames, self.camera),
                 )
             ]
         self.belief[2] = wrap360(start + actual)
@@ -588,6 +598,25 @@ class ScriptedLearner:
             rule="mixing", half_life_s=cfg.half_life_s, dt_s=self.dt
         )
         self.learn_filter.reset(self.belief[2], 2.0)
+
+
+def _landmark_changes(compass: VisualCompass, image: np.ndarray, camera: Camera) -> FrameBearings:
+    """A learning frame's changes for the landmarks. With maps that read the light (a
+    reference level), also as a room :data:`LANDMARK_DIMMED_STOPS` darker shows them:
+    the readings a bearings tracker makes of a dimmer room."""
+    lit = compass.config.exposure in REFERENCE_EXPOSURES
+    dimmed = LANDMARK_DIMMED_STOPS if lit else ()
+    return bands_bearings(image, camera, compass.colors, dimmed_stops=dimmed)
+
+
+def _frame_gains(
+    compass: VisualCompass, images: list[np.ndarray], camera: Camera
+) -> tuple[float, ...]:
+    """The images' :meth:`~vc_gym.compass.VisualCompass.frame_gain` (the light their
+    colour changes are seen at), or none for maps without a reference level."""
+    if compass.config.exposure not in REFERENCE_EXPOSURES:
+        return ()
+    return tuple(compass.frame_gain(image, camera) for image in images)
 
 
 class ScriptedLearning:

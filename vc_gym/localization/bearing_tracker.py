@@ -16,11 +16,15 @@ from vc_gym.compass.light_gain import REFERENCE_EXPOSURES
 from vc_gym.exposure import SessionLight
 from vc_gym.localization.bearing_sensor import BearingSensor
 from vc_gym.localization.pose_tracker import PoseTracker
-from vc_gym.localization.tracker_protocol import TrackerState
+from vc_gym.localization.tracker_protocol import TrackerState, check_frame_inputs
 from vc_gym.validation import int_at_least, open_fraction, positive_float
 
-__all__ = ["SPREAD_RANGE_M", "BearingTracker"]
+__all__ = ["LIGHT_PARTICLES", "LIGHT_SCORE_DECAY", "SPREAD_RANGE_M", "BearingTracker"]
 
+#: How many of the belief's heaviest particles score a reading of the light.
+LIGHT_PARTICLES = 32
+#: Factor by which the light's evidence decays at each check of the light.
+LIGHT_SCORE_DECAY = 0.95
 #: Distance at which a particle cloud's position spread is turned into the bearing
 #: spread it causes (a typical wall distance).
 SPREAD_RANGE_M = 3.0
@@ -48,11 +52,16 @@ class BearingTracker(PoseTracker):
     position seen from :data:`SPREAD_RANGE_M`): a broad cloud is sharpened step by step
     instead of being taken over by the particle that happens to line up a few changes.
 
-    The frames' changes are read at the session's light in whole stops: the median gain
-    of the recent frames (:class:`~vc_gym.exposure.SessionLight` over the maps'
-    per-frame gains), rounded to a power of 2, so that a room at half the light shows
-    the colour classes it was learned in, while the fraction of a stop by which a
-    route's frames read off the learning frames at the same light changes nothing.
+    The frames' changes are read at the session's light relative to the landmarks'
+    learning light, in whole stops, so that a room at half the light shows the changes
+    it was learned with. The median gain of the recent frames
+    (:class:`~vc_gym.exposure.SessionLight` over the maps' per-frame gains) divided by
+    :attr:`~vc_gym.compass.landmarks.LandmarkMap.light_gain` brackets it between two
+    whole stops; it cannot choose between them, since what a route's frames show moves
+    their level by up to two thirds of a stop at the same light. The landmarks choose:
+    every ``light_every``-th frame is read at both, and each reading is scored by how
+    far the changes fit the belief's best particles above the outlier floor; the
+    stop whose decayed score is higher reads the frames.
 
     An atlas without landmarks (learned without ``landmarks=True``) leaves the maps
     alone, with a warning: the tracker is then the pose tracker with its stated spread.
@@ -68,6 +77,9 @@ class BearingTracker(PoseTracker):
     min_changes_alone : int
         Fewest changes of a frame between the checks for the bearings to weigh it alone
         (a large number: the maps weigh every frame as well).
+    light_every : int
+        Frames between the checks of the light by the landmarks (each reads the frame's
+        changes twice).
     resolution_m, resolution_deg : float
         Added in quadrature to the particles' spread in the stated uncertainty (see
         :class:`PoseTracker`); smaller than the pose tracker's, because the bearings
@@ -85,6 +97,7 @@ class BearingTracker(PoseTracker):
         bearing_outlier: float = 0.05,
         bearing_temperature: float = 1.0,
         min_changes_alone: int = 12,
+        light_every: int = 8,
         resolution_m: float = 0.015,
         resolution_deg: float = 0.25,
         outlier: float = 0.001,
@@ -104,15 +117,19 @@ class BearingTracker(PoseTracker):
         self.bearing_outlier = open_fraction("bearing_outlier", bearing_outlier)
         self.bearing_temperature = positive_float("bearing_temperature", bearing_temperature)
         self.min_changes_alone = int_at_least("min_changes_alone", min_changes_alone, 1)
+        self.light_every = int_at_least("light_every", light_every, 1)
         self.sensor: BearingSensor | None = None
         self.bearing_light = SessionLight(self.light.window)  # the maps' light window
         self._changes: FrameBearings | None = None
+        self._light_scores: dict[int, float] = {}  # whole stops: decayed evidence
+        self._light_frame = 0
 
     def reset(self, atlas: CompassAtlas, camera: Camera, dt_s: float) -> None:
         """Forget the pose; (re)build the pose maps and the bearing sensor for ``atlas``."""
         super().reset(atlas, camera, dt_s)
         self.sensor = None
         self.bearing_light.reset()
+        self._light_scores, self._light_frame = {}, 0
         if atlas.landmarks is None or len(atlas.landmarks) == 0:
             warnings.warn(
                 "the atlas has no landmarks (learn it with landmarks=True): the bearings "
@@ -134,20 +151,49 @@ class BearingTracker(PoseTracker):
     ) -> TrackerState:
         """Motion update by ``odometry``, then sensor update by ``image``: the maps and
         the bearings of its colour changes."""
-        self._changes = (
-            None if self.sensor is None else self.sensor.bearings(image, self._light_gain(image))
-        )
+        pan, *_ = check_frame_inputs(head_pan_deg, odometry, ready=self.atlas is not None)
+        self._changes = None if self.sensor is None else self._read_changes(image, pan)
         return super().update(image, head_pan_deg, odometry)
 
-    def _light_gain(self, image: np.ndarray) -> float:
-        """The session's gain (1 for maps without a reference level, or a black frame)."""
+    def _read_changes(self, image: np.ndarray, pan: float) -> FrameBearings:
+        """The frame's changes at the session's light (see the class docstring)."""
         compass = self.maps.maps[0]
         if compass.config.exposure not in REFERENCE_EXPOSURES:
-            return 1.0
-        # in whole stops: the frames of a route read a fraction of a stop off the
-        # learning frames' level at the same light, which the classes tolerate
+            return self.sensor.bearings(image)
         light = self.bearing_light.update(compass.frame_gain(image, self.camera))
-        return 2.0 ** round(math.log2(light))
+        stops = math.log2(light / self.sensor.landmarks.light_gain)
+        low = math.floor(stops)
+        self._light_frame += 1
+        if self._fresh or (self._light_frame - 1) % self.light_every:
+            return self.sensor.bearings(image, 2.0 ** self._light_stop(low, round(stops)))
+        read = {k: self.sensor.bearings(image, 2.0**k) for k in (low, low + 1)}
+        for k in self._light_scores:
+            self._light_scores[k] *= LIGHT_SCORE_DECAY
+        for k, changes in read.items():
+            self._light_scores[k] = self._light_scores.get(k, 0.0) + self._evidence(changes, pan)
+        return read[self._light_stop(low, round(stops))]
+
+    def _light_stop(self, low: int, nearest: int) -> int:
+        """Of the whole stops ``low`` and ``low + 1``, the one the landmarks' decayed
+        evidence favours; ``nearest`` while neither has any."""
+        a, b = self._light_scores.get(low, 0.0), self._light_scores.get(low + 1, 0.0)
+        if a == b:
+            return nearest
+        return low if a > b else low + 1
+
+    def _evidence(self, changes: FrameBearings, pan: float) -> float:
+        """How far the belief's best particles explain ``changes`` above the outlier
+        floor: the log of their weighted mean likelihood ratio against every change
+        being an outlier (0 for a frame without changes; never below 0)."""
+        if len(changes) == 0:
+            return 0.0
+        logw = self.filter.log_weights
+        best = np.argsort(logw)[-LIGHT_PARTICLES:]
+        ll = self.sensor.pose_log_likelihood(
+            changes, self.filter.particles[best], pan, noise_deg=self._bearing_noise_deg()
+        )
+        ratio = ll - len(changes) * math.log(self.bearing_outlier)
+        return _log_mean_exp(ratio, logw[best])
 
     def _fine_alone(self) -> bool:
         changes = self._changes
@@ -161,14 +207,23 @@ class BearingTracker(PoseTracker):
         # from SPREAD_RANGE_M away), so that the bearings sharpen it step by step instead
         # of seizing the particle that happens to line up a few changes. The spread of
         # the cloud's core: the few particles drawn afresh at a check must not blunt it.
+        spread = self._bearing_noise_deg()
+        ll = self.sensor.pose_log_likelihood(self._changes, poses, pan, noise_deg=spread)
+        return ll / self.bearing_temperature
+
+    def _bearing_noise_deg(self) -> float:
+        """The bearing noise widened by the spread of the cloud's core."""
         heading_deg, position_m = _core_spread(self.filter.particles, self.filter.weights)
-        spread = math.hypot(
+        return math.hypot(
             self.bearing_noise_deg,
             heading_deg,
             math.degrees(math.atan2(position_m, SPREAD_RANGE_M)),
         )
-        ll = self.sensor.pose_log_likelihood(self._changes, poses, pan, noise_deg=spread)
-        return ll / self.bearing_temperature
+
+
+def _log_mean_exp(values: np.ndarray, log_weights: np.ndarray) -> float:
+    """``log(Σ w·exp(values) / Σ w)`` for weights given as logs, without overflow."""
+    return float(np.logaddexp.reduce(values + log_weights) - np.logaddexp.reduce(log_weights))
 
 
 def _weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
