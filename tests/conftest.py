@@ -123,11 +123,12 @@ def learned_room_atlas(room: Room, config: CompassConfig | None = None) -> Compa
 
 
 def learned_room_turn(
-    room: Room, x: float, y: float, colors=None, yaws=LEARN_YAWS
+    room: Room, x: float, y: float, colors=None, yaws=LEARN_YAWS, config=None
 ) -> VisualCompass:
     """A full turn learned at ``(x, y)`` in ``room`` from ``yaws`` (colour classes fitted
-    on that spot's 0-pan views unless ``colors`` are given)."""
-    vc = VisualCompass(CompassConfig(), colors)
+    on that spot's 0-pan views unless ``colors`` are given), with ``config`` (default
+    the paper's)."""
+    vc = VisualCompass(config or CompassConfig(), colors)
     if colors is None:
         vc.fit_colors([render_room_view(room, x, y, Camera(yaw_deg=a)) for a in range(0, 360, 45)])
     for a in yaws:

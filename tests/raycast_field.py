@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from vc_gym.compass import Camera, CompassAtlas, wrap180
+from vc_gym.exposure import gain_table
 from vc_gym.worlds.room import make_room, render_room_view
 
 WIDTH_M, DEPTH_M = 5.0, 4.0
@@ -23,21 +24,31 @@ def field_room():
     return make_room(np.random.default_rng(5), width_m=WIDTH_M, depth_m=DEPTH_M)
 
 
-def field_atlas(room, learn_room_turn) -> CompassAtlas:
-    """Six spots 1 m apart, each with four shorter turns 0.5 m around it."""
+def field_atlas(room, learn_room_turn, config=None) -> CompassAtlas:
+    """Six spots 1 m apart, each with four shorter turns 0.5 m around it (compass
+    ``config``: default the paper's)."""
     entries, colors = {}, None
     for i, (x, y) in enumerate(SPOTS):
-        vc = learn_room_turn(room, x, y, colors, YAWS)
+        vc = learn_room_turn(room, x, y, colors, YAWS, config)
         colors = vc.colors
         entries[f"spot{i}"] = ((x, y), vc)
         for side, (dx, dy) in AROUND.items():
-            turn = learn_room_turn(room, x + dx, y + dy, colors, YAWS[1::3])
+            turn = learn_room_turn(room, x + dx, y + dy, colors, YAWS[1::3], config)
             entries[f"spot{i}.{side}"] = ((x + dx, y + dy), turn)
     return CompassAtlas(entries, home="spot0")
 
 
-def walk(room, atlas, tracker, frames: int = 200, kidnap_at: int | None = None, seed: int = 1):
-    """Errors per frame of a walk between random waypoints with the head scanning."""
+def walk(
+    room,
+    atlas,
+    tracker,
+    frames: int = 200,
+    kidnap_at: int | None = None,
+    seed: int = 1,
+    light: float = 1.0,
+):
+    """Errors per frame of a walk between random waypoints with the head scanning, the
+    room's light times ``light``."""
     rng = np.random.default_rng(seed)
     tracker.reset(atlas, Camera(), 0.1)
     pose = np.array([0.2, -0.3, 30.0])
@@ -58,6 +69,8 @@ def walk(room, atlas, tracker, frames: int = 200, kidnap_at: int | None = None, 
         pose[2] %= 360.0
         pan = 30.0 * math.sin(0.3 * f)
         image = render_room_view(room, pose[0], pose[1], Camera(yaw_deg=pose[2] + pan))
+        if light != 1.0:
+            image = np.take(gain_table(light), image)
         noise = rng.normal(0, (0.002, 0.002, 0.2))
         odo = (fwd * 1.05 + noise[0], noise[1], turn * 0.97 + noise[2])
         s = tracker.update(image, pan, odo)

@@ -8,14 +8,17 @@ from the atlas' own turns at their known poses.
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from raycast_field import AROUND, SPOTS, YAWS, field_atlas, field_room, walk
 
-from vc_gym.compass import Camera
+from vc_gym.compass import Camera, CompassConfig
 from vc_gym.compass.bearings import bands_bearings
 from vc_gym.compass.landmarks import LearnedView, learn_landmarks
+from vc_gym.envs.learning import LANDMARK_DIMMED_STOPS
+from vc_gym.exposure import SessionLight
 from vc_gym.localization import BearingTracker, PoseTracker, Tracker, make_tracker
 from vc_gym.worlds.room import render_room_view
 
@@ -39,6 +42,46 @@ def atlas(room, learn_room_turn):
                 views.append(LearnedView(bands_bearings(image, camera, colors), a, x + dx, y + dy))
     atlas.landmarks = learn_landmarks(views)
     return atlas
+
+
+@pytest.fixture(scope="module")
+def lit_atlas(room, learn_room_turn):
+    """The field's atlas learned with maps that read the light (``exposure="mean"``), its
+    landmarks as the learning phase learns them: each frame read also as a room one stop
+    darker shows it, and the frames' light kept."""
+    atlas = field_atlas(room, learn_room_turn, CompassConfig(exposure="mean"))
+    first = atlas.compasses[0]
+    views, gains = [], []
+    for x, y in SPOTS:
+        for (dx, dy), yaws in [((0.0, 0.0), YAWS)] + [(d, YAWS[1::3]) for d in AROUND.values()]:
+            for a in yaws:
+                camera = Camera(yaw_deg=a)
+                image = render_room_view(room, x + dx, y + dy, camera)
+                changes = bands_bearings(
+                    image, camera, first.colors, dimmed_stops=LANDMARK_DIMMED_STOPS
+                )
+                views.append(LearnedView(changes, a, x + dx, y + dy))
+                gains.append(first.frame_gain(image, camera))
+    atlas.landmarks = replace(learn_landmarks(views), light_gain=SessionLight.of(gains))
+    return atlas
+
+
+@pytest.mark.parametrize(
+    ("light", "off_stops", "stop"), [(1.0, 0.0, 0), (0.5, 0.0, 1), (1.0, 0.6, 0), (0.5, -0.6, 1)]
+)
+def test_the_landmarks_choose_the_light_a_frame_is_read_at(room, lit_atlas, light, off_stops, stop):
+    """At full light and at half the light the tracker settles on the whole stop the
+    room's light calls for, and tracks as finely at both; also when the session's
+    light reads 0.6 stop off (here: the learning light stated off), which would round
+    to the wrong stop. Measured: 5.6 and 3.9 cm, 0.8° and 0.9°."""
+    lit = copy.copy(lit_atlas)
+    lm = lit_atlas.landmarks
+    lit.landmarks = replace(lm, light_gain=lm.light_gain * 2.0**-off_stops)
+    tracker = BearingTracker(seed=3)
+    errors = walk(room, lit, tracker, frames=130, seed=1, light=light)
+    scores = tracker._light_scores
+    assert max(scores, key=scores.get) == stop, scores
+    assert errors[50:, 1].mean() < 0.1 and errors[50:, 0].mean() < 2.0
 
 
 #: Frames of the walks scored: settled before the kidnapping (frame 130), and 3 s after.

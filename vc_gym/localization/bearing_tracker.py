@@ -60,8 +60,8 @@ class BearingTracker(PoseTracker):
     whole stops; it cannot choose between them, since what a route's frames show moves
     their level by up to two thirds of a stop at the same light. The landmarks choose:
     every ``light_every``-th frame is read at both, and each reading is scored by how
-    far the changes fit the belief's best particles above the outlier floor; the
-    stop whose decayed score is higher reads the frames.
+    far the changes fit the belief's best particles above the outlier floor (every
+    frame at first); the stop whose decayed score is higher reads the frames.
 
     An atlas without landmarks (learned without ``landmarks=True``) leaves the maps
     alone, with a warning: the tracker is then the pose tracker with its stated spread.
@@ -164,7 +164,10 @@ class BearingTracker(PoseTracker):
         stops = math.log2(light / self.sensor.landmarks.light_gain)
         low = math.floor(stops)
         self._light_frame += 1
-        if self._fresh or (self._light_frame - 1) % self.light_every:
+        # every frame of the first 2 x light_every (the light is not known yet), then
+        # every light_every-th
+        settled = self._light_frame > 2 * self.light_every
+        if self._fresh or (settled and (self._light_frame - 1) % self.light_every):
             return self.sensor.bearings(image, 2.0 ** self._light_stop(low, round(stops)))
         read = {k: self.sensor.bearings(image, 2.0**k) for k in (low, low + 1)}
         for k in self._light_scores:
