@@ -51,6 +51,15 @@ def test_stands_at_home_with_hysteresis():
     assert p.predict(obs(0.2, 0.0))[0] > 0.0
 
 
+def test_the_head_looks_ahead_while_walking_unless_told_to_scan():
+    ahead = policy(settle_time_s=0.0)
+    assert {float(ahead.predict(obs(2.0, 0.0))[3]) for _ in range(8)} == {0.0}
+    scanning = policy(settle_time_s=0.0, walk_scan_deg=(-60.0, 0.0, 60.0, 0.0))
+    actions = [scanning.predict(obs(2.0, 0.0)) for _ in range(8)]
+    assert all(a[0] > 0 for a in actions)  # walking all the while
+    assert [float(a[3]) for a in actions[:4]] == [0.0, 60.0, 0.0, -60.0]
+
+
 def test_for_env_needs_a_velocity_action():
     class NoScaling:
         unwrapped = object()
@@ -66,6 +75,9 @@ def test_for_env_needs_a_velocity_action():
         {"home_tolerance_m": -0.1},
         {"head_scan_deg": ()},
         {"head_scan_deg": (100.0,)},
+        {"walk_scan_deg": ()},
+        {"walk_scan_deg": (float("nan"),)},
+        {"walk_scan_deg": "left"},
         {"rearm_factor": 0.5},
         {"settle_time_s": float("nan")},
     ],

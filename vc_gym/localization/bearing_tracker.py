@@ -14,6 +14,7 @@ from vc_gym.compass import Camera, CompassAtlas
 from vc_gym.compass.bearings import FrameBearings
 from vc_gym.compass.light_gain import REFERENCE_EXPOSURES
 from vc_gym.exposure import SessionLight
+from vc_gym.localization.bearing_search import search_poses
 from vc_gym.localization.bearing_sensor import BearingSensor
 from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import TrackerState, check_frame_inputs
@@ -21,6 +22,15 @@ from vc_gym.validation import int_at_least, open_fraction, positive_float
 
 __all__ = ["LIGHT_PARTICLES", "LIGHT_SCORE_DECAY", "SPREAD_RANGE_M", "BearingTracker"]
 
+#: Percentile of the landmarks' positions taken as the walls (each side) when a search
+#: widens the tracker's bounds.
+LANDMARK_EXTENT_PCT = 5.0
+#: Fewest changes of a frame for the field search (fewer fit many poses).
+MIN_SEARCH_CHANGES = 6
+#: Bearing noise (deg) at which the search's poses and the belief are compared.
+SEARCH_NOISE_DEG = 2.0
+#: Spread (x m, y m, θ deg) of the particles drawn around the search's poses.
+SEARCH_SPREAD = (0.08, 0.08, 2.0)
 #: How many of the belief's heaviest particles score a reading of the light.
 LIGHT_PARTICLES = 32
 #: Factor by which the light's evidence decays at each check of the light.
@@ -80,6 +90,16 @@ class BearingTracker(PoseTracker):
     light_every : int
         Frames between the checks of the light by the landmarks (each reads the frame's
         changes twice).
+    search_every : int
+        Every how many of the maps' checks the frame's changes are also searched for over
+        the whole field (:func:`~vc_gym.localization.bearing_search.search_poses`); 0:
+        never. When the search's best pose fits the changes better than the belief by
+        ``search_nats`` at two such checks running, the belief is taken as lost (as the
+        maps' check does), and half of the particles drawn anew come from the search:
+        the maps, learned at the spots, place a robot far from them poorly, while the
+        landmarks are seen from anywhere.
+    search_nats : float
+        How much better the search's best pose must fit (log-likelihood, nats).
     resolution_m, resolution_deg : float
         Added in quadrature to the particles' spread in the stated uncertainty (see
         :class:`PoseTracker`); smaller than the pose tracker's, because the bearings
@@ -98,6 +118,8 @@ class BearingTracker(PoseTracker):
         bearing_temperature: float = 1.0,
         min_changes_alone: int = 12,
         light_every: int = 8,
+        search_every: int = 0,
+        search_nats: float = 5.0,
         resolution_m: float = 0.015,
         resolution_deg: float = 0.25,
         outlier: float = 0.001,
@@ -118,11 +140,16 @@ class BearingTracker(PoseTracker):
         self.bearing_temperature = positive_float("bearing_temperature", bearing_temperature)
         self.min_changes_alone = int_at_least("min_changes_alone", min_changes_alone, 1)
         self.light_every = int_at_least("light_every", light_every, 1)
+        self.search_every = int_at_least("search_every", search_every, 0)
+        self.search_nats = positive_float("search_nats", search_nats)
         self.sensor: BearingSensor | None = None
         self.bearing_light = SessionLight(self.light.window)  # the maps' light window
         self._changes: FrameBearings | None = None
         self._light_scores: dict[int, float] = {}  # whole stops: decayed evidence
         self._light_frame = 0
+        self._found: tuple[np.ndarray, np.ndarray] | None = None  # this check's search
+        self._checks = self._search_run = 0
+        self._pan = 0.0
 
     def reset(self, atlas: CompassAtlas, camera: Camera, dt_s: float) -> None:
         """Forget the pose; (re)build the pose maps and the bearing sensor for ``atlas``."""
@@ -130,6 +157,7 @@ class BearingTracker(PoseTracker):
         self.sensor = None
         self.bearing_light.reset()
         self._light_scores, self._light_frame = {}, 0
+        self._found, self._checks, self._search_run = None, 0, 0
         if atlas.landmarks is None or len(atlas.landmarks) == 0:
             warnings.warn(
                 "the atlas has no landmarks (learn it with landmarks=True): the bearings "
@@ -153,7 +181,70 @@ class BearingTracker(PoseTracker):
         the bearings of its colour changes."""
         pan, *_ = check_frame_inputs(head_pan_deg, odometry, ready=self.atlas is not None)
         self._changes = None if self.sensor is None else self._read_changes(image, pan)
+        self._pan, self._found = pan, None
+        if self.search_every and self._changes is not None:
+            check = self._fresh or self._frame % self.rescore_every == 0  # as the maps'
+            if check:
+                self._checks += 1
+                if (self._checks - 1) % self.search_every == 0:
+                    self._found = self._search()
         return super().update(image, head_pan_deg, odometry)
+
+    def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The pose tracker's bounds, with a search widened to the landmarks' extent
+        (the walls they stand on hold the field: a kidnapping may leave the robot
+        farther from the spots than their margin)."""
+        lo, hi = super()._bounds()
+        landmarks = self.atlas.landmarks
+        if not self.search_every or landmarks is None or len(landmarks) < 2:
+            return lo, hi
+        # the outermost few per cent may be triangulated far beyond the walls
+        walls = np.percentile(
+            landmarks.positions, [LANDMARK_EXTENT_PCT, 100 - LANDMARK_EXTENT_PCT], axis=0
+        )
+        return np.minimum(lo, walls[0]), np.maximum(hi, walls[1])
+
+    def _search(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The poses anywhere on the field that the frame's changes fit best
+        (``None`` for a frame with too few changes to place it)."""
+        if len(self._changes) < MIN_SEARCH_CHANGES:
+            return None
+        bounds = (self._lo[0], self._hi[0], self._lo[1], self._hi[1])
+        poses, ll = search_poses(self.sensor, self._changes, self._pan, bounds)
+        return (poses, ll) if len(poses) else None
+
+    def _check_lost(self, scores: np.ndarray, ll: np.ndarray) -> None:
+        """The maps' check, and with a search the bearings' own: the search's best pose
+        against the belief's expected fit at the same noise."""
+        super()._check_lost(scores, ll)
+        if self._found is None:
+            return
+        poses, found_ll = self._found
+        fit = self.sensor.pose_log_likelihood(
+            self._changes, self.filter.particles, self._pan, noise_deg=SEARCH_NOISE_DEG
+        )
+        logw = self.filter.log_weights
+        gap = float(found_ll[0]) - _log_mean_exp(fit, logw)
+        self._search_run = self._search_run + 1 if gap > self.search_nats else 0
+        if self._search_run >= 2:
+            self._lost_run, self._search_run = max(self._lost_run, self.lost_checks), 0
+
+    def _drawn(self, scores: np.ndarray, pan: float, k: int) -> np.ndarray:
+        """``k`` body poses drawn anew: with this check's search, half of them around its
+        poses (weighted by their fit), the rest from the maps as :class:`PoseTracker`
+        draws them."""
+        if self._found is None:
+            return super()._drawn(scores, pan, k)
+        poses, found_ll = self._found
+        n = k // 2
+        out = np.empty((k, 3))
+        out[: k - n] = super()._drawn(scores, pan, k - n)
+        p = np.exp(found_ll - found_ll.max())
+        picked = self.rng.choice(len(poses), size=n, p=p / p.sum())
+        out[k - n :] = poses[picked] + self.rng.normal(0.0, SEARCH_SPREAD, (n, 3))
+        np.clip(out[k - n :, :2], self._lo, self._hi, out=out[k - n :, :2])
+        out[k - n :, 2] %= 360.0
+        return out
 
     def _read_changes(self, image: np.ndarray, pan: float) -> FrameBearings:
         """The frame's changes at the session's light (see the class docstring)."""

@@ -222,8 +222,7 @@ class PoseTracker:
         check_reset_inputs(atlas, camera, dt_s)
         self.maps = pose_maps_of(atlas, self.lattice_m, self.reach_m)
         self.atlas, self.camera = atlas, camera
-        lo = self.maps.positions.min(axis=0) - self.margin_m
-        hi = self.maps.positions.max(axis=0) + self.margin_m
+        lo, hi = self._bounds()
         self._lo, self._hi = lo, hi
         self.rng = np.random.default_rng(self.seed)
         self.filter = ParticleFilter(
@@ -283,6 +282,13 @@ class PoseTracker:
         return self._state()
 
     # ------------------------------------------------------------------ parts
+    def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Where the robot may be: ``margin_m`` around the spots (their turns too)."""
+        return (
+            self.maps.positions.min(axis=0) - self.margin_m,
+            self.maps.positions.max(axis=0) + self.margin_m,
+        )
+
     def _gain(self, image: np.ndarray) -> float | None:
         """The session's gain for ``exposure="session"`` maps, else ``None`` (the maps'
         own rule)."""
