@@ -20,7 +20,16 @@ from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import TrackerState, check_frame_inputs
 from vc_gym.validation import int_at_least, open_fraction, positive_float
 
-__all__ = ["LIGHT_PARTICLES", "LIGHT_SCORE_DECAY", "SPREAD_RANGE_M", "BearingTracker"]
+__all__ = [
+    "LANDMARK_EXTENT_PCT",
+    "LIGHT_PARTICLES",
+    "LIGHT_SCORE_DECAY",
+    "MIN_SEARCH_CHANGES",
+    "SEARCH_NOISE_DEG",
+    "SEARCH_SPREAD",
+    "SPREAD_RANGE_M",
+    "BearingTracker",
+]
 
 #: Percentile of the landmarks' positions taken as the walls (each side) when a search
 #: widens the tracker's bounds.
