@@ -60,6 +60,18 @@ def test_the_head_looks_ahead_while_walking_unless_told_to_scan():
     assert [float(a[3]) for a in actions[:4]] == [0.0, 60.0, 0.0, -60.0]
 
 
+def test_an_unsure_belief_turns_to_look_instead_of_walking_or_standing():
+    p = policy(settle_time_s=0.0, look_std_m=0.3, look_turn_deg_s=45.0)
+    unsure = {**obs(2.0, 0.0), "position_std": np.array([0.5, 0.1])}
+    a = p.predict(unsure)
+    assert a[0] == 0.0 and a[2] == pytest.approx(45.0)  # turning on the spot, not still
+    assert not ScriptedHomingPolicy.is_still(a)
+    sure = {**obs(2.0, 0.0), "position_std": np.array([0.1, 0.1])}
+    assert p.predict(sure)[0] > 0.0  # walks home once the belief is narrow
+    settling = policy(settle_time_s=1.0, look_std_m=0.3)
+    assert settling.predict(unsure)[2] == 0.0  # the settling time comes first
+
+
 def test_for_env_needs_a_velocity_action():
     class NoScaling:
         unwrapped = object()
@@ -78,6 +90,8 @@ def test_for_env_needs_a_velocity_action():
         {"walk_scan_deg": ()},
         {"walk_scan_deg": (float("nan"),)},
         {"walk_scan_deg": "left"},
+        {"look_std_m": 0.0},
+        {"look_turn_deg_s": float("inf")},
         {"rearm_factor": 0.5},
         {"settle_time_s": float("nan")},
     ],

@@ -68,6 +68,7 @@ def test_modes_choose_the_learning_and_the_policy():
     assert bearings.learning["landmarks"] is True
     assert not bearings.policy.get("verify_home") and bearings.policy["home_tolerance_m"] <= 0.05
     assert max(bearings.policy["walk_scan_deg"]) > 0  # the head scans while walking
+    assert bearings.policy["look_std_m"] > 0  # an unsure belief looks around
     pose = homing_mode("pose-home")
     assert pose.tracker == "pose-grid" and pose.learning["around_m"] > 0
     assert pose.policy["verify_home"]

@@ -48,6 +48,14 @@ class ScriptedHomingPolicy:
         Head pans cycled while walking too (beyond the paper, whose head looks ahead):
         a tracker that sees both sides of the room on the way home is not fooled by one
         side fitting a pose nearby. Default ``None``: head straight while walking.
+    look_std_m : float, optional
+        Beyond the paper: while the tracker's position standard deviation (the larger
+        axis of ``position_std``) exceeds this after settling, the robot neither walks
+        nor stands but turns on the spot at ``look_turn_deg_s``, scanning with the head:
+        an unsure belief gets new views instead of leading the robot astray, and the
+        task does not take the wait for a stop. Default ``None``: never.
+    look_turn_deg_s : float
+        Turn rate while looking.
     settle_time_s : float
         Time to stand still at the start of homing.
     max_spread_deg : float
@@ -108,6 +116,8 @@ class ScriptedHomingPolicy:
         home_offset_m: tuple[float, float] = (0.0, 0.0),
         sure_std_m: float | None = None,
         walk_scan_deg: tuple[float, ...] | None = None,
+        look_std_m: float | None = None,
+        look_turn_deg_s: float = 45.0,
     ):
         if not callable(velocity_action):
             raise ValueError(f"velocity_action must be callable, got {velocity_action!r}")
@@ -119,6 +129,7 @@ class ScriptedHomingPolicy:
             ("verify_tolerance_m", verify_tolerance_m),
             ("verify_gain", verify_gain),
             ("verify_turn_deg_s", verify_turn_deg_s),
+            ("look_turn_deg_s", look_turn_deg_s),
         ):
             positive_float(name, v)
         nonnegative_float("settle_time_s", settle_time_s)
@@ -152,6 +163,8 @@ class ScriptedHomingPolicy:
         self.verify_turn_deg_s = float(verify_turn_deg_s)
         self.home_offset_m = home_offset(home_offset_m)
         self.sure_std_m = None if sure_std_m is None else positive_float("sure_std_m", sure_std_m)
+        self.look_std_m = None if look_std_m is None else positive_float("look_std_m", look_std_m)
+        self.look_turn_deg_s = float(look_turn_deg_s)
         self.reset()
 
     @classmethod
@@ -185,8 +198,12 @@ class ScriptedHomingPolicy:
             return self._verifying(obs)
         fwd_home, left_home = self._home_vector(obs)
         spread = float(obs["heading_spread"][0])
-        settling = self._t * self.dt_s < self.settle_time_s or spread > self.max_spread_deg
+        settled = self._t * self.dt_s >= self.settle_time_s
+        settling = not settled or spread > self.max_spread_deg
         self._t += 1
+        if settled and self._unsure(obs):
+            pan = self._next_pan(self.head_scan_deg)
+            return self.velocity_action(turn_deg_s=self.look_turn_deg_s, pan_deg=pan)
         dist = math.hypot(fwd_home, left_home)
         # hysteresis: once arrived, only a clearly wrong estimate makes the robot move
         tol = self.home_tolerance_m
@@ -199,12 +216,21 @@ class ScriptedHomingPolicy:
         forward, turn = 0.0, 0.0
         if not settling and not self._arrived:
             forward, turn = self._walk_towards(fwd_home, left_home)
-        pans = self.head_scan_deg if forward == 0.0 else self.walk_scan_deg
-        pan = 0.0
-        if pans is not None:
-            self._scan_i = (self._scan_i + 1) % len(pans)
-            pan = pans[self._scan_i]
+        pan = self._next_pan(self.head_scan_deg if forward == 0.0 else self.walk_scan_deg)
         return self.velocity_action(forward_m_s=forward, turn_deg_s=turn, pan_deg=pan)
+
+    def _next_pan(self, pans: tuple[float, ...] | None) -> float:
+        """The next head pan of the scan ``pans`` (``None``: straight ahead)."""
+        if pans is None:
+            return 0.0
+        self._scan_i = (self._scan_i + 1) % len(pans)
+        return pans[self._scan_i]
+
+    def _unsure(self, obs: dict[str, np.ndarray]) -> bool:
+        """The position belief is too wide to walk on (``look_std_m``)."""
+        if self.look_std_m is None:
+            return False
+        return float(np.max(obs["position_std"])) > self.look_std_m
 
     def _sure(self, obs: dict[str, np.ndarray]) -> bool:
         """The position belief is sure enough to stop without checking (``sure_std_m``)."""

@@ -83,8 +83,9 @@ WALK_HEAD_SCAN_DEG = (-60.0, -30.0, 0.0, 30.0, 60.0, 30.0, 0.0, -30.0)
 #: from the learned spots is placed from the landmarks in a second or two instead of
 #: ten or more). The robot scans with its head while it walks (``walk_scan_deg``) and,
 #: wider than the paper's scan, while it stands (``head_scan_deg``), so that the
-#: bearings see both sides of the room; it stops within 4 cm of home by its estimate,
-#: without a checking turn.
+#: bearings see both sides of the room; while its position belief is wider than 0.3 m
+#: it turns on the spot, looking (``look_std_m``); it stops within 4 cm of home by its
+#: estimate, without a checking turn.
 HOMING_MODES: dict[str, HomingMode] = {
     "paper": HomingMode(learning={}, policy={}),
     "check-home": HomingMode(learning={"normalise_at": "start"}, policy={"verify_home": True}),
@@ -104,6 +105,7 @@ HOMING_MODES: dict[str, HomingMode] = {
             "home_tolerance_m": 0.04,
             "head_scan_deg": WIDE_HEAD_SCAN_DEG,
             "walk_scan_deg": WALK_HEAD_SCAN_DEG,
+            "look_std_m": 0.3,
             "settle_time_s": 1.0,
         },
         tracker={"type": "bearings", "search_every": 1},
