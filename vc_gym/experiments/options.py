@@ -61,9 +61,9 @@ HOMING_MODE_HELP = (
     "home and every spot, homing on the pose-grid tracker (the pose belief away from home, "
     "the paper's filters near it) and checking home with a full turn; bearings-home: "
     "pose-home's learning with the colour changes kept as landmarks, homing on the "
-    "bearings tracker with its field search, the head scanning while walking, stopping "
-    "within 4 cm by its estimate without a checking turn; improved: deprecated name of "
-    "check-home"
+    "bearings tracker with its field search, the head scanning while walking, turning "
+    "to look while unsure, stopping within 4 cm by its estimate without a checking turn; "
+    "improved: deprecated name of check-home"
 )
 
 
