@@ -97,3 +97,12 @@ def test_register_tracker():
             register_tracker("x", "not callable")
     finally:
         TRACKERS.pop("still", None)
+
+
+def test_a_spec_has_a_short_label_for_titles():
+    from vc_gym.localization import GridTracker, tracker_label
+
+    assert tracker_label("pose-grid") == "pose-grid"
+    assert tracker_label({"type": "bearings", "search_every": 1}) == "bearings"
+    assert tracker_label({"n_particles": 10}) == "custom"  # no type: not a name
+    assert tracker_label(GridTracker) == "custom" and tracker_label(GridTracker()) == "custom"

@@ -26,7 +26,7 @@ from vc_gym.experiments.episode import (
     run_episode,
 )
 from vc_gym.jobs.output import new_figure, new_out_dir, save_figure, write_json
-from vc_gym.localization import TrackerSpec, make_tracker
+from vc_gym.localization import TrackerSpec, make_tracker, tracker_label
 from vc_gym.sim.top_view import TopView
 from vc_gym.validation import (
     MAX_HOMING_S,
@@ -115,7 +115,7 @@ def run_demo(
             summary = {
                 "task": "learn 4 spots 1 m around home, kidnapping, homing (scripted)",
                 "scene": "robolab",
-                "tracker": tracker if isinstance(tracker, str) else "custom",
+                "tracker": tracker_label(tracker),
                 "learning_seed": seed,
                 "mode": mode,
                 **record.summary(),

@@ -60,7 +60,13 @@ from vc_gym.localization.kalman_tracker import KalmanTracker
 from vc_gym.localization.particle_tracker import ParticleTracker
 from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.position import AtlasPositionFilter
-from vc_gym.localization.registry import TRACKERS, TrackerSpec, make_tracker, register_tracker
+from vc_gym.localization.registry import (
+    TRACKERS,
+    TrackerSpec,
+    make_tracker,
+    register_tracker,
+    tracker_label,
+)
 from vc_gym.localization.shortlist import SpotShortlist
 from vc_gym.localization.spot_scores import mean_spot_scores
 from vc_gym.localization.tracker_protocol import Tracker, TrackerState
@@ -91,4 +97,5 @@ __all__ = [
     "make_tracker",
     "mean_spot_scores",
     "register_tracker",
+    "tracker_label",
 ]

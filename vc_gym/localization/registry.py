@@ -14,7 +14,7 @@ from vc_gym.localization.pose_tracker import PoseTracker
 from vc_gym.localization.tracker_protocol import Tracker
 from vc_gym.plugins import make_plugin, register_plugin
 
-__all__ = ["TRACKERS", "TrackerSpec", "make_tracker", "register_tracker"]
+__all__ = ["TRACKERS", "TrackerSpec", "make_tracker", "register_tracker", "tracker_label"]
 
 #: Tracker classes by name (``register_tracker`` adds to it).
 TRACKERS: dict[str, Callable[..., Tracker]] = {
@@ -32,6 +32,16 @@ TrackerSpec = str | Mapping[str, Any] | Callable[[], Tracker] | Tracker | None
 def register_tracker(name: str, factory: Callable[..., Tracker], overwrite: bool = False) -> None:
     """Make ``factory(**kwargs)`` available as ``make_tracker(name)`` / ``{"type": name}``."""
     register_plugin(TRACKERS, "tracker", name, factory, overwrite)
+
+
+def tracker_label(spec: TrackerSpec) -> str:
+    """A short name of ``spec`` for titles and summaries: the name, a dict's ``type``,
+    else ``"custom"`` (a callable or a built tracker)."""
+    if isinstance(spec, str):
+        return spec
+    if isinstance(spec, Mapping) and isinstance(spec.get("type"), str):
+        return spec["type"]
+    return "custom"
 
 
 def make_tracker(spec: TrackerSpec = "grid") -> Tracker:

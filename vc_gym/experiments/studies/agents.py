@@ -28,6 +28,7 @@ from vc_gym.experiments.studies import get_experiment
 from vc_gym.experiments.studies.common import ExperimentOptions
 from vc_gym.experiments.studies.kidnapping import PAPER_MEAN_CM, PAPER_STD_CM, mean_std
 from vc_gym.jobs.output import check_out_dir, new_figure, save_figure, write_json
+from vc_gym.localization import tracker_label
 
 __all__ = ["agent_list", "run_agents", "summary_lines"]
 
@@ -264,7 +265,7 @@ def _plot(path: Path, per_agent: dict[str, dict[str, Any]], summary: dict[str, A
     s = summary["settings"]
     ax.set_title(
         f"same {len(s['seeds'])} learning seeds × {s['episodes_per_seed']} kidnappings, "
-        f"{s['tracker'] if isinstance(s['tracker'], str) else 'custom'} tracker",
+        f"{tracker_label(s['tracker'])} tracker",
         fontsize=10,
     )
     ax.legend(fontsize=7, loc="upper right")

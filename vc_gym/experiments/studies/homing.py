@@ -49,6 +49,7 @@ from vc_gym.heading_sensors import IMAGE_SENSORS, SENSOR_GRID, current_sensor_na
 from vc_gym.jobs.job import Job
 from vc_gym.jobs.output import new_figure, save_figure
 from vc_gym.jobs.workers import worker_cache
+from vc_gym.localization import tracker_label
 from vc_gym.sim.aibo_room import AiboRoomEnv
 from vc_gym.sim.scenes import check_scene_name
 from vc_gym.validation import flag, positive_float
@@ -448,7 +449,7 @@ def _plot_stops(path: Path, episodes, settings, overall) -> None:
     ax.set_aspect("equal")
     ax.set_xlabel("x offset from home (cm)")
     ax.set_ylabel("y offset from home (cm)")
-    tracker = settings["tracker"] if isinstance(settings["tracker"], str) else "custom"
+    tracker = tracker_label(settings["tracker"])
     ax.set_title(
         f"{settings['agent']} ({tracker} tracker, {settings.get('mode', 'paper')} mode), "
         f"{overall['episodes']} kidnappings:\n"
