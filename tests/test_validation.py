@@ -107,3 +107,12 @@ def test_bounded_floats_take_their_bound_and_name_it_with_the_unit():
 def test_nonnegative_float_at_most_refuses_what_nonnegative_float_refuses(value):
     with pytest.raises(ValueError, match="^t must be (finite|a real number)"):
         nonnegative_float_at_most("t", value, 60.0)
+
+
+def test_head_pans_are_a_non_empty_sequence_within_90_degrees():
+    from vc_gym.validation import head_pans
+
+    assert head_pans("pans", [-40, 0, 40.5]) == (-40.0, 0.0, 40.5)
+    for bad in ((), (100.0,), (float("nan"),), "left", None, (0.0, "x")):
+        with pytest.raises(ValueError, match="pans must be non-empty pans within"):
+            head_pans("pans", bad)

@@ -25,6 +25,7 @@ __all__ = [
     "finite_float",
     "finite_real",
     "flag",
+    "head_pans",
     "int_at_least",
     "int_in_range",
     "nonnegative_float",
@@ -99,6 +100,18 @@ def positive_float(name: str, value: object) -> float:
     if not (math.isfinite(v) and v > 0):
         raise ValueError(f"{name} must be finite and > 0, got {value!r}")
     return v
+
+
+def head_pans(name: str, value: object) -> tuple[float, ...]:
+    """``value`` as a non-empty tuple of head pans within ±90° (degrees), else a
+    ``ValueError``."""
+    try:
+        pans = tuple(float(p) for p in value)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        pans = ()
+    if not pans or not all(abs(p) <= 90 for p in pans):
+        raise ValueError(f"{name} must be non-empty pans within ±90°, got {value!r}")
+    return pans
 
 
 def open_fraction(name: str, value: object) -> float:

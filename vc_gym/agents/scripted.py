@@ -17,7 +17,7 @@ import numpy as np
 from vc_gym.envs.homing import goal_vector, home_offset
 from vc_gym.envs.learning import HEAD_SCAN_DEG
 from vc_gym.poses import body_to_world, world_to_body
-from vc_gym.validation import nonnegative_float, positive_float
+from vc_gym.validation import head_pans, nonnegative_float, positive_float
 
 __all__ = ["ScriptedHomingAgent", "ScriptedHomingPolicy"]
 
@@ -133,15 +133,12 @@ class ScriptedHomingPolicy:
         ):
             positive_float(name, v)
         nonnegative_float("settle_time_s", settle_time_s)
-        _check_pans("head_scan_deg", head_scan_deg)
-        if walk_scan_deg is not None:
-            _check_pans("walk_scan_deg", walk_scan_deg)
         self.velocity_action = velocity_action
         self.dt_s = float(dt_s)
         self.home_tolerance_m = float(home_tolerance_m)
-        self.head_scan_deg = tuple(float(p) for p in head_scan_deg)
+        self.head_scan_deg = head_pans("head_scan_deg", head_scan_deg)
         self.walk_scan_deg = (
-            None if walk_scan_deg is None else tuple(float(p) for p in walk_scan_deg)
+            None if walk_scan_deg is None else head_pans("walk_scan_deg", walk_scan_deg)
         )
         self.settle_time_s = float(settle_time_s)
         self.max_spread_deg = float(max_spread_deg)
@@ -293,16 +290,6 @@ class ScriptedHomingPolicy:
     def is_still(action: np.ndarray, threshold: float = 0.05) -> bool:
         """No body motion commanded (the head may move)."""
         return bool(np.all(np.abs(np.asarray(action)[:3]) <= threshold))
-
-
-def _check_pans(name: str, pans: object) -> None:
-    """``pans``: a non-empty sequence of head pans within ±90°, else a ``ValueError``."""
-    try:
-        ok = len(pans) > 0 and all(abs(float(p)) <= 90 for p in pans)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
-        raise ValueError(f"{name} must be non-empty pans within ±90°, got {pans!r}")
 
 
 class ScriptedHomingAgent:

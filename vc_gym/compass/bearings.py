@@ -158,8 +158,7 @@ def bands_bearings(
     dimmed = [positive_float("dimmed_stops", v) for v in dimmed_stops]
     found = _read_bands(image, camera, colors, bands, min_run_px, max_gap_px, gain)
     for stops in dimmed:
-        img = check_image(image, "image")
-        darker = np.take(gain_table(2.0**-stops), img)
+        darker = np.take(gain_table(2.0**-stops), image)  # checked by the reading above
         other = _read_bands(
             darker, camera, colors, bands, min_run_px, max_gap_px, gain * 2.0**stops
         )

@@ -180,19 +180,11 @@ class LandmarkMap:
             )
         half = math.radians(bearings.hfov_deg) / 2.0
         log_floor = math.log(outlier)
-        # the candidates: every (change, landmark of its pair), grouped by change
-        order = np.argsort(self.pairs, kind="stable")
-        sorted_pairs = self.pairs[order]
-        observed = bearings.pairs
-        lo = np.searchsorted(sorted_pairs, observed, side="left")
-        count = np.searchsorted(sorted_pairs, observed, side="right") - lo
-        matched = count > 0
-        total += log_floor * int(np.count_nonzero(~matched))
-        if not matched.any():
+        landmark, change = self.candidates(bearings.pairs)
+        n_matched = int(np.count_nonzero(np.bincount(change, minlength=len(bearings))))
+        total += log_floor * (len(bearings) - n_matched)
+        if n_matched == 0:
             return total
-        c = count[matched]
-        landmark = order[_gather(lo[matched], lo[matched] + c)]
-        change = np.repeat(np.flatnonzero(matched), c)
         offsets = np.radians(bearings.offsets_deg)
         # a tracker's cloud is tight but for a few particles drawn afresh far away, which
         # would widen the reach of every pose: those are scored apart
@@ -200,9 +192,25 @@ class LandmarkMap:
         for poses in _pose_groups(eye_xy, camera_yaw_rad):
             out[poses] = self._candidates_score(
                 landmark, change, offsets, eye_xy[poses], camera_yaw_rad[poses],
-                noise_rad, half, log_floor, int(np.count_nonzero(matched)),
+                noise_rad, half, log_floor, n_matched,
             )  # fmt: skip
         return total + out
+
+    def candidates(self, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every (landmark, change) of one band and colour pair, for changes with pair
+        codes ``pairs`` (:attr:`FrameBearings.pairs`).
+
+        Returns
+        -------
+        landmark, change : numpy.ndarray
+            ``(C,)`` landmark indices and ``(C,)`` indices into ``pairs``, grouped by
+            change in order (a change no landmark shares has none).
+        """
+        order = np.argsort(self.pairs, kind="stable")
+        sorted_pairs = self.pairs[order]
+        lo = np.searchsorted(sorted_pairs, pairs, side="left")
+        count = np.searchsorted(sorted_pairs, pairs, side="right") - lo
+        return order[_gather(lo, lo + count)], np.repeat(np.arange(len(pairs)), count)
 
     def _candidates_score(
         self,

@@ -37,6 +37,7 @@ from vc_gym.validation import (
     MAX_LEARN_TIME_S,
     finite_float,
     flag,
+    head_pans,
     int_at_least,
     nonnegative_float,
     positive_float,
@@ -160,10 +161,7 @@ class LearningConfig:
                 f"around_m must be at most half of spot_distance_m ({self.spot_distance_m:g} m)"
                 f", got {self.around_m!r}"
             )
-        if not self.head_scan_deg or any(abs(p) > 90 for p in self.head_scan_deg):
-            raise ValueError(
-                f"head_scan_deg must be non-empty pans within ±90°, got {self.head_scan_deg}"
-            )
+        head_pans("head_scan_deg", self.head_scan_deg)
         if self.normalise_at not in NORMALISE_AT:
             raise ValueError(
                 f"normalise_at must be one of {NORMALISE_AT}, got {self.normalise_at!r}"

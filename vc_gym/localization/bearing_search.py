@@ -74,14 +74,9 @@ def search_poses(
     pan = math.radians(float(head_pan_deg))
     empty = np.zeros((0, 3)), np.zeros(0)
     lm = sensor.landmarks
-    order = np.argsort(lm.pairs, kind="stable")
-    sorted_pairs = lm.pairs[order]
-    lo = np.searchsorted(sorted_pairs, changes.pairs, side="left")
-    count = np.searchsorted(sorted_pairs, changes.pairs, side="right") - lo
-    if len(changes) == 0 or not np.any(count):
+    landmark, change = lm.candidates(changes.pairs)
+    if landmark.size == 0:
         return empty
-    change = np.repeat(np.arange(len(changes)), count)
-    landmark = order[np.repeat(lo - np.cumsum(count) + count, count) + np.arange(count.sum())]
     xs = np.arange(x0, x1 + 1e-9, spacing)
     ys = np.arange(y0, y1 + 1e-9, spacing)
     eye = np.stack(np.meshgrid(xs, ys, indexing="ij"), -1).reshape(-1, 2)  # (G, 2)

@@ -192,8 +192,7 @@ class BearingTracker(PoseTracker):
         self._changes = None if self.sensor is None else self._read_changes(image, pan)
         self._pan, self._found = pan, None
         if self.search_every and self._changes is not None:
-            check = self._fresh or self._frame % self.rescore_every == 0  # as the maps'
-            if check:
+            if self._check_due():
                 self._checks += 1
                 if (self._checks - 1) % self.search_every == 0:
                     self._found = self._search()

@@ -263,7 +263,7 @@ class PoseTracker:
         if outside.size:  # the robot stays in the room: particles stay near the spots
             p[outside, :2] = np.clip(p[outside, :2], self._lo, self._hi)
             pf.replace(outside, p[outside])
-        check = self._fresh or self._frame % self.rescore_every == 0
+        check = self._check_due()
         self._frame += 1
         if not check and self._fine_alone():
             # between the checks a finer measurement alone weighs the particles
@@ -282,6 +282,11 @@ class PoseTracker:
         return self._state()
 
     # ------------------------------------------------------------------ parts
+    def _check_due(self) -> bool:
+        """Whether the next frame is a check: the maps score every spot (the first
+        frame, then every ``rescore_every``-th)."""
+        return self._fresh or self._frame % self.rescore_every == 0
+
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Where the robot may be: ``margin_m`` around the spots (their turns too)."""
         return (
